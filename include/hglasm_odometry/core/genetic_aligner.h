@@ -1,0 +1,60 @@
+// GLASM genetic pre-alignment: a GA over (x, y, theta) in a box centred on the odometry guess.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "hglasm_odometry/core/lookup_table.h"
+#include "hglasm_odometry/core/pose2d.h"
+
+namespace hglasm {
+
+/// Half-extents of the search box around the guess.
+struct SearchBox {
+  double half_x = 0.3;      ///< metres
+  double half_y = 0.3;      ///< metres
+  double half_theta = 0.3;  ///< radians, at most pi
+};
+
+struct GeneticOptions {
+  SearchBox box;
+  int population = 20;
+  int generations = 6;
+  int runs = 1;                ///< independent GA runs; the best result wins
+  int bits_per_gene = 9;       ///< Gray-coded resolution of x, y and theta over the box
+  double crossover_rate = 0.8;
+  double mutation_rate = 0.03;  ///< per bit
+  int tournament_size = 2;
+  std::uint64_t seed = 1;
+};
+
+struct PreAlignResult {
+  Pose2D pose;                    ///< best pose found (new scan in the reference frame)
+  std::uint32_t fitness = 0;      ///< its fitness
+  double fitness_ratio = 0.0;     ///< fitness / (max cell value * points): 1 = every point on a reference point
+  int evaluations = 0;            ///< fitness evaluations spent
+};
+
+/// Not thread-safe per instance (it owns its random generator); separate instances are independent.
+class GeneticAligner {
+ public:
+  explicit GeneticAligner(const GeneticOptions& options = {});
+
+  /// Searches the box around `guess` for the pose maximising table.fitness(points, pose).
+  /// If `population_out` is given it receives the final population of the best run (for display).
+  PreAlignResult align(const LookupTable& table, const std::vector<Eigen::Vector2d>& points,
+                       const Pose2D& guess, std::vector<Pose2D>* population_out = nullptr);
+
+  /// Restarts the random sequence (same seed -> same results).
+  void reseed(std::uint64_t seed) { rng_.seed(seed); }
+
+  const GeneticOptions& options() const { return options_; }
+
+ private:
+  GeneticOptions options_;
+  std::mt19937_64 rng_;
+};
+
+}  // namespace hglasm

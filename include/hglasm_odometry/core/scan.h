@@ -1,0 +1,59 @@
+// Laser scan geometry: polar ranges -> Cartesian points, with REP-117 validity.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "hglasm_odometry/core/pose2d.h"
+
+namespace hglasm {
+
+/// The polar fields of a sensor_msgs/LaserScan, without ROS. Beam i has angle
+/// angle_min + i * angle_increment; the increment may be negative (descending scans).
+struct RangeScan {
+  std::vector<float> ranges;
+  double angle_min = 0.0;
+  double angle_increment = 0.0;
+  double range_min = 0.0;
+  double range_max = std::numeric_limits<double>::infinity();
+};
+
+/// How a RangeScan becomes points. Ranges outside [max(range_min, min_range), min(range_max, max_range)],
+/// NaN, +-inf, zero and negative ranges are invalid and never used (REP-117).
+struct ScanConversionOptions {
+  double min_range = 0.0;                                        ///< extra lower limit, metres
+  double max_range = std::numeric_limits<double>::infinity();    ///< extra upper limit, metres
+  int beam_step = 1;                                             ///< keep every n-th beam (decimation)
+  bool mirror = false;  ///< negate beam angles: an upside-down laser seen from above
+};
+
+/// Valid points of one scan in the sensor frame, in beam order.
+struct Scan {
+  std::vector<Eigen::Vector2d> points;
+  std::vector<int> beam_index;  ///< original beam index of each point (consecutive beams are neighbours)
+  int beam_count = 0;           ///< beams in the source scan, valid or not
+  int invalid_count = 0;        ///< beams dropped as invalid
+
+  std::size_t size() const { return points.size(); }
+  bool empty() const { return points.empty(); }
+};
+
+/// Why a RangeScan could not be converted at all (its points are then empty).
+enum class ScanError { kNone, kNoBeams, kBadAngles, kBadRangeLimits };
+const char* toString(ScanError error);
+
+/// Converts polar ranges into Cartesian points. Never throws; a structurally broken scan (no beams,
+/// non-finite or zero increment with several beams, ...) yields an empty Scan and sets *error.
+Scan scanFromRanges(const RangeScan& ranges, const ScanConversionOptions& options = {},
+                    ScanError* error = nullptr);
+
+/// The points whose original beam index has the given parity (0 = even beams, 1 = odd beams).
+Scan selectBeams(const Scan& scan, int parity);
+
+/// Applies `pose` to every point (beam indices kept).
+Scan transformScan(const Scan& scan, const Pose2D& pose);
+
+}  // namespace hglasm

@@ -1,0 +1,102 @@
+// HGLASM-g: genetic pre-alignment on a graded lookup table, refined by MbICP, composed in SE(2).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hglasm_odometry/core/genetic_aligner.h"
+#include "hglasm_odometry/core/lookup_table.h"
+#include "hglasm_odometry/core/mbicp.h"
+#include "hglasm_odometry/core/pose2d.h"
+#include "hglasm_odometry/core/scan.h"
+
+namespace hglasm {
+
+/// The matcher family of the papers, selectable for comparison.
+enum class Algorithm {
+  kHglasmG,       ///< graded-table GA, then MbICP (the method)
+  kHglasmBinary,  ///< binary-table GA, then MbICP
+  kGlasmG,        ///< graded-table GA alone
+  kGlasmBinary,   ///< binary-table GA alone
+  kMbicp,         ///< MbICP alone from the guess
+};
+const char* toString(Algorithm algorithm);
+/// Parses "hglasm_g", "hglasm_binary", "glasm_g", "glasm_binary", "mbicp". False if unknown.
+bool parseAlgorithm(const std::string& name, Algorithm* algorithm);
+bool usesGeneticStage(Algorithm algorithm);
+bool usesMbicpStage(Algorithm algorithm);
+
+/// Search-space presets of the papers' Table 1.
+enum class Preset { kSmall, kMedium, kLarge };
+const char* toString(Preset preset);
+bool parsePreset(const std::string& name, Preset* preset);
+
+struct MatcherOptions {
+  Algorithm algorithm = Algorithm::kHglasmG;
+  LookupTableOptions table;  ///< `kind` is overridden by the algorithm
+  GeneticOptions genetic;
+  MbicpOptions mbicp;
+};
+
+/// Built-in defaults of each preset (config/presets.yaml holds the same values for ROS users).
+MatcherOptions presetOptions(Preset preset);
+
+enum class MatchStatus {
+  kOk,
+  kNoReference,          ///< match() before setReference(), or an empty reference
+  kTooFewPoints,         ///< the new scan has too few valid points
+  kLowFitness,           ///< (pre-alignment alone) nothing in the box fits
+  kMbicpFailed,          ///< MbICP: too few associations or degenerate geometry
+  kMbicpNotConverged,    ///< MbICP hit its iteration limit (result usable, flagged)
+};
+const char* toString(MatchStatus status);
+
+struct MatchResult {
+  Pose2D pose;                 ///< new scan in the reference frame (final)
+  Pose2D prealigned_pose;      ///< after the GA (the guess when there is no GA stage)
+  MatchStatus status = MatchStatus::kNoReference;
+  std::uint32_t fitness = 0;   ///< GA fitness of prealigned_pose
+  double fitness_ratio = 0.0;  ///< fitness / (max cell * points), in [0, 1]
+  int evaluations = 0;         ///< GA fitness evaluations
+  int iterations = 0;          ///< MbICP iterations
+  int associations = 0;
+  double rms_error = 0.0;      ///< MbICP residual, metres
+  MbicpStatus mbicp_status = MbicpStatus::kConverged;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  ///< of (x, y, theta); see Mbicp
+  double prealign_ms = 0.0;
+  double refine_ms = 0.0;
+
+  bool ok() const { return status == MatchStatus::kOk; }
+};
+
+/// One reference at a time; its lookup table and MbICP structure are built once in setReference().
+class ScanMatcher {
+ public:
+  explicit ScanMatcher(const MatcherOptions& options = {});
+
+  /// Builds the lookup table (if the algorithm has a GA stage) and the MbICP reference.
+  void setReference(const Scan& reference);
+  bool hasReference() const { return has_reference_; }
+  double lastTableBuildMs() const { return table_build_ms_; }
+
+  /// Matches `scan` (points in its own frame) against the reference, starting from `guess`.
+  MatchResult match(const Scan& scan, const Pose2D& guess,
+                    std::vector<Pose2D>* population_out = nullptr);
+
+  const MatcherOptions& options() const { return options_; }
+  const LookupTable& table() const { return table_; }
+  void reseed(std::uint64_t seed) { aligner_.reseed(seed); }
+
+ private:
+  MatcherOptions options_;
+  LookupTable table_;
+  GeneticAligner aligner_;
+  Mbicp mbicp_;
+  bool has_reference_ = false;
+  std::size_t reference_size_ = 0;
+  double table_build_ms_ = 0.0;
+};
+
+}  // namespace hglasm
