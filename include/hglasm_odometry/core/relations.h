@@ -1,0 +1,44 @@
+// The Kümmerle et al. 2009 relations metric: errors of estimated relative motions against reference ones.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hglasm_odometry/core/pose2d.h"
+
+namespace hglasm {
+
+/// Pose of the robot at t2 expressed in the robot frame at t1.
+struct Relation {
+  double t1 = 0.0;
+  double t2 = 0.0;
+  Pose2D motion;
+};
+
+/// Reads `t1 t2 x y z roll pitch yaw` lines (z, roll, pitch ignored). False with *error on failure.
+bool readRelations(const std::string& path, std::vector<Relation>* relations, std::string* error);
+
+struct StampedPose {
+  double stamp = 0.0;
+  Pose2D pose;
+};
+
+struct RelationStats {
+  int count = 0;             ///< relations evaluated
+  int missing = 0;           ///< relations whose stamps are not in the trajectory
+  double trans_mean = 0.0;   ///< metres
+  double trans_std = 0.0;
+  double rot_mean_deg = 0.0; ///< absolute rotational error, degrees
+  double rot_std_deg = 0.0;
+  double trans_sq_mean = 0.0;    ///< m^2
+  double rot_sq_mean_deg = 0.0;  ///< deg^2
+};
+
+/// Evaluates the relations whose span |t2 - t1| is at most `max_span` seconds (<= 0: all) against
+/// `trajectory` (sorted by stamp). A relation's stamps must each match a trajectory stamp within
+/// `stamp_tolerance` seconds, else it counts as missing.
+RelationStats evaluateRelations(const std::vector<Relation>& relations,
+                                const std::vector<StampedPose>& trajectory, double max_span,
+                                double stamp_tolerance = 1e-3);
+
+}  // namespace hglasm
