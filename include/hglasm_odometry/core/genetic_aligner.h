@@ -27,6 +27,17 @@ struct GeneticOptions {
   double crossover_rate = 0.8;
   double mutation_rate = 0.03;  ///< per bit
   int tournament_size = 2;
+  int elite_count = 1;          ///< best individuals copied unchanged into the next generation
+  /// Fitness uses at most this many of the new scan's points, evenly spread over the scan (0 = all):
+  /// the coarse search does not need every beam, and its cost is linear in the points.
+  int max_points = 0;
+  /// After the GA, a pattern search (hill climbing with halving steps) on the same fitness polishes the
+  /// best pose to about a cell: the GA's resolution and few generations leave it centimetres off, and
+  /// MbICP converges more reliably from closer. At most this many evaluations (0 = off).
+  int polish_evaluations = 60;
+  /// Coarse-to-fine: the first `coarse_generations` generations of each run score poses on the coarse
+  /// table (a wide sigma, so the basin around the true pose is wide), the rest on the fine one.
+  int coarse_generations = 0;
   std::uint64_t seed = 1;
 };
 
@@ -34,7 +45,7 @@ struct PreAlignResult {
   Pose2D pose;                    ///< best pose found (new scan in the reference frame)
   std::uint32_t fitness = 0;      ///< its fitness
   double fitness_ratio = 0.0;     ///< fitness / (max cell value * points): 1 = every point on a reference point
-  int evaluations = 0;            ///< fitness evaluations spent
+  int evaluations = 0;  ///< fitness evaluations: 1 (guess) + population * generations * runs + polish
 };
 
 /// Not thread-safe per instance (it owns its random generator); separate instances are independent.
@@ -44,8 +55,10 @@ class GeneticAligner {
 
   /// Searches the box around `guess` for the pose maximising table.fitness(points, pose).
   /// If `population_out` is given it receives the final population of the best run (for display).
+  /// `coarse_table` (optional) is used for the first options().coarse_generations generations.
   PreAlignResult align(const LookupTable& table, const std::vector<Eigen::Vector2d>& points,
-                       const Pose2D& guess, std::vector<Pose2D>* population_out = nullptr);
+                       const Pose2D& guess, std::vector<Pose2D>* population_out = nullptr,
+                       const LookupTable* coarse_table = nullptr);
 
   /// Restarts the random sequence (same seed -> same results).
   void reseed(std::uint64_t seed) { rng_.seed(seed); }
@@ -53,8 +66,12 @@ class GeneticAligner {
   const GeneticOptions& options() const { return options_; }
 
  private:
+  void polish(const LookupTable& table, const FitnessPoints& points, PreAlignResult* result) const;
+
   GeneticOptions options_;
   std::mt19937_64 rng_;
+  std::vector<Eigen::Vector2d> subset_;  // scratch: the points the fitness uses
+  FitnessPoints prepared_;               // scratch: the same, prepared for the table
 };
 
 }  // namespace hglasm

@@ -10,13 +10,13 @@ namespace hglasm {
 
 class OdometryBuffer {
  public:
-  explicit OdometryBuffer(double max_age = 10.0) : max_age_(max_age) {}
+  explicit OdometryBuffer(double max_age = 30.0) : max_age_(max_age) {}
 
   /// Adds a sample. Out-of-order samples are inserted in place; non-finite ones are rejected (false).
   bool add(double stamp, const Pose2D& pose);
 
   /// Pose at `stamp`, interpolated between the two samples around it. Outside the buffered span it
-  /// extrapolates by at most `max_extrapolation` seconds from the nearest end; beyond, false.
+  /// holds the nearest sample for at most `max_extrapolation` seconds; beyond, false.
   bool poseAt(double stamp, double max_extrapolation, Pose2D* pose) const;
 
   double newestStamp() const;

@@ -25,6 +25,10 @@ struct TrackerOptions {
   double odometry_max_extrapolation = 0.25;  ///< seconds; beyond, wheel odometry counts as stale
   double max_time_jump = 60.0;        ///< seconds forward between scans that triggers a reset
   bool use_odometry = true;
+  /// Wheel odometry implying faster motion than this between two scans is implausible (a jump): the
+  /// constant-velocity prediction is used instead. A margin of 0.2 m / 0.2 rad is added for jitter.
+  double max_odometry_speed = 5.0;       ///< m/s
+  double max_odometry_turn_rate = 6.0;   ///< rad/s
   /// Odometry translation noise per metre and rotation noise per radian (for the guess covariance).
   double odometry_noise_xy = 0.05;
   double odometry_noise_theta = 0.05;
@@ -64,9 +68,13 @@ class OdometryTracker {
   /// Wheel odometry: pose of the base in the wheel-odometry frame at `stamp`.
   void addOdometry(double stamp, const Pose2D& odom_pose);
 
-  /// Processes one scan (points in the laser frame) taken at `stamp` (seconds).
+  /// Processes one scan (points in the laser frame) taken at `stamp` (seconds). If `population_out` is
+  /// given, it receives the GA's final population as base poses in the odometry frame (for display).
   TrackerUpdate processScan(double stamp, const Scan& scan,
                             std::vector<Pose2D>* population_out = nullptr);
+
+  /// Makes the next processed scan a keyframe (e.g. the scanner's geometry changed).
+  void requestKeyframe() { keyframe_requested_ = true; }
 
   /// Restarts from the identity pose with no keyframe (odometry history kept).
   void reset();
@@ -76,7 +84,7 @@ class OdometryTracker {
   int keyframeId() const { return keyframe_id_; }
 
  private:
-  bool predict(double stamp, Pose2D* predicted, PredictionSource* source) const;
+  PredictionSource predict(double stamp, Pose2D* predicted, std::string* warning) const;
   void setKeyframe(double stamp, const Scan& scan, const Pose2D& pose,
                    const Eigen::Matrix3d& covariance);
 
@@ -92,7 +100,10 @@ class OdometryTracker {
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
   bool velocity_valid_ = false;
 
+  bool has_keyframe_ = false;
+  bool keyframe_requested_ = false;
   int keyframe_id_ = 0;
+  int keyframe_beam_count_ = 0;
   double keyframe_stamp_ = 0.0;
   Pose2D keyframe_pose_;
   Eigen::Matrix3d keyframe_covariance_ = Eigen::Matrix3d::Zero();

@@ -36,6 +36,8 @@ bool parsePreset(const std::string& name, Preset* preset);
 struct MatcherOptions {
   Algorithm algorithm = Algorithm::kHglasmG;
   LookupTableOptions table;  ///< `kind` is overridden by the algorithm
+  /// Table for the GA's first genetic.coarse_generations generations (same kind as `table`).
+  LookupTableOptions coarse_table{TableKind::kGraded, 0.06, 0.30, 0.60, 0.30, 0.10};
   GeneticOptions genetic;
   MbicpOptions mbicp;
 };
@@ -92,6 +94,7 @@ class ScanMatcher {
  private:
   MatcherOptions options_;
   LookupTable table_;
+  LookupTable coarse_table_;
   GeneticAligner aligner_;
   Mbicp mbicp_;
   bool has_reference_ = false;

@@ -1,0 +1,215 @@
+#include "hglasm_odometry/core/genetic_aligner.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hglasm {
+namespace {
+
+std::uint64_t grayToBinary(std::uint64_t gray) {
+  for (std::uint64_t shift = gray >> 1; shift; shift >>= 1) gray ^= shift;
+  return gray;
+}
+
+/// Chromosome layout: three Gray-coded genes of `bits` bits each, x | y | theta (theta lowest).
+class Codec {
+ public:
+  Codec(const SearchBox& box, const Pose2D& centre, int bits)
+      : bits_(bits), mask_((std::uint64_t{1} << bits) - 1), centre_(centre) {
+    const double levels = static_cast<double>(mask_);
+    scale_[0] = 2.0 * box.half_x / levels;
+    scale_[1] = 2.0 * box.half_y / levels;
+    // A full-turn box would put -pi and +pi on two distinct genes: spread the levels over [-pi, pi).
+    const double theta_span = box.half_theta >= M_PI ? 2.0 * M_PI * levels / (levels + 1.0) : 2.0 * box.half_theta;
+    scale_[2] = theta_span / levels;
+    low_[0] = -box.half_x;
+    low_[1] = -box.half_y;
+    low_[2] = box.half_theta >= M_PI ? -M_PI : -box.half_theta;
+  }
+
+  int totalBits() const { return 3 * bits_; }
+
+  /// The offset from the centre is applied in the guess's frame: the box is aligned with the guess.
+  Pose2D decode(std::uint64_t chromosome) const {
+    double offset[3];
+    for (int gene = 0; gene < 3; ++gene) {
+      const std::uint64_t gray = (chromosome >> ((2 - gene) * bits_)) & mask_;
+      offset[gene] = low_[gene] + scale_[gene] * static_cast<double>(grayToBinary(gray));
+    }
+    return Pose2D(centre_.x + offset[0], centre_.y + offset[1], centre_.theta + offset[2]);
+  }
+
+ private:
+  int bits_;
+  std::uint64_t mask_;
+  Pose2D centre_;
+  double scale_[3];
+  double low_[3];
+};
+
+struct Individual {
+  std::uint64_t chromosome = 0;
+  std::uint32_t fitness = 0;
+};
+
+}  // namespace
+
+GeneticAligner::GeneticAligner(const GeneticOptions& options) : options_(options), rng_(options.seed) {
+  options_.population = std::max(2, options_.population);
+  options_.generations = std::max(1, options_.generations);
+  options_.runs = std::max(1, options_.runs);
+  options_.bits_per_gene = std::clamp(options_.bits_per_gene, 2, 20);
+  options_.tournament_size = std::max(1, options_.tournament_size);
+  options_.box.half_theta = std::min(std::abs(options_.box.half_theta), M_PI);
+  options_.box.half_x = std::abs(options_.box.half_x);
+  options_.box.half_y = std::abs(options_.box.half_y);
+}
+
+PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector<Eigen::Vector2d>& all_points,
+                                     const Pose2D& guess, std::vector<Pose2D>* population_out,
+                                     const LookupTable* coarse_table) {
+  const std::size_t limit = options_.max_points > 0 ? static_cast<std::size_t>(options_.max_points) : all_points.size();
+  const std::vector<Eigen::Vector2d>* selected = &all_points;
+  if (all_points.size() > limit) {
+    subset_.clear();
+    for (std::size_t i = 0; i < limit; ++i) subset_.push_back(all_points[i * all_points.size() / limit]);
+    selected = &subset_;
+  }
+  FitnessPoints& points = prepared_;
+  points.assign(*selected);
+  PreAlignResult result;
+  result.pose = guess;
+  // The guess itself competes: the GA never returns something worse than the prediction.
+  result.fitness = table.fitness(points, guess);
+  result.evaluations = 1;
+
+  const Codec codec(options_.box, guess, options_.bits_per_gene);
+  const int total_bits = codec.totalBits();
+  const std::uint64_t all_bits = (std::uint64_t{1} << total_bits) - 1;
+  const int population_size = options_.population;
+  std::uniform_int_distribution<std::uint64_t> random_chromosome(0, all_bits);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::uniform_int_distribution<int> random_member(0, population_size - 1);
+  std::uniform_int_distribution<int> random_cut(1, total_bits - 1);
+
+  std::vector<Individual> population(population_size), offspring(population_size);
+  const int elite_count = std::clamp(options_.elite_count, 1, population_size - 1);
+  const int coarse_generations = coarse_table && !coarse_table->empty() ? options_.coarse_generations : 0;
+  const LookupTable* scoring = &table;
+  auto evaluate = [&](Individual& individual) {
+    individual.fitness = scoring->fitness(points, codec.decode(individual.chromosome));
+    ++result.evaluations;
+  };
+  auto tournament = [&]() -> const Individual& {
+    const Individual* winner = &population[random_member(rng_)];
+    for (int k = 1; k < options_.tournament_size; ++k) {
+      const Individual& challenger = population[random_member(rng_)];
+      if (challenger.fitness > winner->fitness) winner = &challenger;
+    }
+    return *winner;
+  };
+  // Each bit flips with probability mutation_rate: one random byte per bit, compared with a threshold
+  // (resolution 1/256), eight bits per 64-bit draw.
+  const unsigned mutation_threshold =
+      static_cast<unsigned>(std::clamp(std::lround(options_.mutation_rate * 256.0), 0L, 256L));
+  auto mutate = [&](std::uint64_t chromosome) {
+    std::uint64_t random_bytes = 0;
+    for (int bit = 0; bit < total_bits; ++bit) {
+      if (bit % 8 == 0) random_bytes = rng_();
+      if ((random_bytes & 0xFF) < mutation_threshold) chromosome ^= std::uint64_t{1} << bit;
+      random_bytes >>= 8;
+    }
+    return chromosome;
+  };
+
+  std::vector<Individual> best_run_population;
+  std::uint32_t best_run_fitness = 0;
+  for (int run = 0; run < options_.runs; ++run) {
+    scoring = coarse_generations > 0 ? coarse_table : &table;
+    for (auto& individual : population) {
+      individual.chromosome = random_chromosome(rng_);
+      evaluate(individual);
+    }
+    for (int generation = 1; generation < options_.generations; ++generation) {
+      if (generation == coarse_generations) {
+        scoring = &table;  // switch to the fine table: rescore the survivors on it
+        for (auto& individual : population) evaluate(individual);
+      }
+      // Elitism: the best individuals survive unchanged (no re-evaluation needed).
+      std::partial_sort(population.begin(), population.begin() + elite_count, population.end(),
+                        [](const Individual& a, const Individual& b) { return a.fitness > b.fitness; });
+      std::copy(population.begin(), population.begin() + elite_count, offspring.begin());
+      for (int i = elite_count; i < population_size; i += 2) {
+        std::uint64_t child_a = tournament().chromosome;
+        std::uint64_t child_b = tournament().chromosome;
+        if (unit(rng_) < options_.crossover_rate) {
+          // One-point crossover on the bit string: exchange the tails below a random cut.
+          const std::uint64_t tail = (std::uint64_t{1} << random_cut(rng_)) - 1;
+          const std::uint64_t swap = (child_a ^ child_b) & tail;
+          child_a ^= swap;
+          child_b ^= swap;
+        }
+        offspring[i].chromosome = mutate(child_a);
+        evaluate(offspring[i]);
+        if (i + 1 < population_size) {
+          offspring[i + 1].chromosome = mutate(child_b);
+          evaluate(offspring[i + 1]);
+        }
+      }
+      population.swap(offspring);
+    }
+    const auto best = std::max_element(population.begin(), population.end(),
+                                       [](const Individual& a, const Individual& b) { return a.fitness < b.fitness; });
+    if (best->fitness > result.fitness) {
+      result.fitness = best->fitness;
+      result.pose = codec.decode(best->chromosome);
+    }
+    if (population_out && (run == 0 || best->fitness > best_run_fitness)) {
+      best_run_fitness = best->fitness;
+      best_run_population = population;
+    }
+  }
+
+  polish(table, points, &result);
+
+  if (population_out) {
+    population_out->clear();
+    for (const auto& individual : best_run_population) population_out->push_back(codec.decode(individual.chromosome));
+  }
+  const double max_fitness = static_cast<double>(table.maxCellValue()) * static_cast<double>(points.size());
+  result.fitness_ratio = max_fitness > 0.0 ? result.fitness / max_fitness : 0.0;
+  return result;
+}
+
+void GeneticAligner::polish(const LookupTable& table, const FitnessPoints& points,
+                            PreAlignResult* result) const {
+  // Compass search: try +-step on each axis, move to the first improvement, halve the steps when none.
+  const double cell = table.options().cell_size;
+  double step_xy = 4.0 * cell;
+  double step_theta = 0.02;
+  int budget = options_.polish_evaluations;
+  while (budget > 0 && step_xy >= 0.5 * cell) {
+    bool improved = false;
+    const Pose2D centre = result->pose;
+    const Pose2D moves[6] = {Pose2D(step_xy, 0, 0),  Pose2D(-step_xy, 0, 0),   Pose2D(0, step_xy, 0),
+                             Pose2D(0, -step_xy, 0), Pose2D(0, 0, step_theta), Pose2D(0, 0, -step_theta)};
+    for (const Pose2D& move : moves) {
+      if (budget-- <= 0) break;
+      const Pose2D candidate(centre.x + move.x, centre.y + move.y, centre.theta + move.theta);
+      const std::uint32_t fitness = table.fitness(points, candidate);
+      ++result->evaluations;
+      if (fitness > result->fitness) {
+        result->fitness = fitness;
+        result->pose = candidate;
+        improved = true;
+        break;
+      }
+    }
+    if (!improved) {
+      step_xy *= 0.5;
+      step_theta *= 0.5;
+    }
+  }
+}
+
+}  // namespace hglasm

@@ -1,0 +1,207 @@
+#include "hglasm_odometry/core/lookup_table.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hglasm {
+
+LookupTable::LookupTable(const LookupTableOptions& options) : options_(options) {
+  // Guard against nonsense sizes here too; the ROS layer validates and names the parameter.
+  if (!(options_.cell_size > 1e-4)) options_.cell_size = 0.02;
+  if (!(options_.sigma > 0.0)) options_.sigma = 0.1;
+  if (!(options_.cutoff >= options_.cell_size)) options_.cutoff = std::max(options_.cell_size, 3 * options_.sigma);
+  inv_cell_size_ = 1.0 / options_.cell_size;
+  buildKernel();
+}
+
+void LookupTable::buildKernel() {
+  // The stamp around one reference point, precomputed once: the value of a cell is the likelihood of
+  // the distance from the reference point's cell centre to this cell's centre.
+  const double reach = options_.kind == TableKind::kGraded ? options_.cutoff : options_.sigma;
+  kernel_radius_ = static_cast<int>(std::ceil(reach * inv_cell_size_ - 1e-9));
+  const int side = 2 * kernel_radius_ + 1;
+  kernel_.assign(static_cast<std::size_t>(side) * side, 0);
+  const double inv_two_sigma_sq = 1.0 / (2.0 * options_.sigma * options_.sigma);
+  for (int dy = -kernel_radius_; dy <= kernel_radius_; ++dy) {
+    for (int dx = -kernel_radius_; dx <= kernel_radius_; ++dx) {
+      std::uint8_t value = 0;
+      if (options_.kind == TableKind::kGraded) {
+        const double distance = std::hypot(dx, dy) * options_.cell_size;
+        if (distance <= options_.cutoff) {
+          value = static_cast<std::uint8_t>(std::lround(255.0 * std::exp(-distance * distance * inv_two_sigma_sq)));
+        }
+      } else {
+        value = 1;  // the whole square
+      }
+      kernel_[(dy + kernel_radius_) * side + dx + kernel_radius_] = value;
+    }
+  }
+}
+
+std::uint32_t LookupTable::maxCellValue() const { return options_.kind == TableKind::kGraded ? 255u : 1u; }
+
+std::size_t LookupTable::memoryBytes() const {
+  return tile_index_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() + kernel_.capacity();
+}
+
+void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
+  tiles_in_use_ = 0;
+  tiles_x_ = tiles_y_ = 0;
+  tile_index_.clear();
+
+  // Global cell coordinates of the usable reference points, and their bounding box.
+  long min_cx = 0, max_cx = -1, min_cy = 0, max_cy = -1;
+  std::vector<std::pair<long, long>> cells;
+  cells.reserve(reference.size());
+  // Stamp centres: the points, plus samples along short gaps between consecutive points, spaced so that
+  // every point of the segment is within a quarter sigma of a sample.
+  samples_.clear();
+  const double spacing = std::max(options_.cell_size, 0.5 * options_.sigma);
+  const Eigen::Vector2d* previous = nullptr;
+  for (const auto& p : reference) {
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
+    if (previous && options_.segment_max_gap > 0.0) {
+      const double range = std::min(previous->norm(), p.norm());
+      const double max_gap = options_.segment_max_gap + options_.segment_gap_per_metre * range;
+      const double gap = (p - *previous).norm();
+      if (gap < max_gap && gap > spacing) {
+        const int pieces = static_cast<int>(std::ceil(gap / spacing));
+        for (int k = 1; k < pieces; ++k) samples_.push_back(*previous + (p - *previous) * (double(k) / pieces));
+      }
+    }
+    samples_.push_back(p);
+    previous = &p;
+  }
+  for (const auto& p : samples_) {
+    if (std::abs(p.x()) > kMaxCoordinate || std::abs(p.y()) > kMaxCoordinate) continue;
+    const long cx = static_cast<long>(std::floor(p.x() * inv_cell_size_));
+    const long cy = static_cast<long>(std::floor(p.y() * inv_cell_size_));
+    if (cells.empty()) {
+      min_cx = max_cx = cx;
+      min_cy = max_cy = cy;
+    } else {
+      min_cx = std::min(min_cx, cx), max_cx = std::max(max_cx, cx);
+      min_cy = std::min(min_cy, cy), max_cy = std::max(max_cy, cy);
+    }
+    cells.emplace_back(cx, cy);
+  }
+  if (cells.empty()) return;
+
+  // Tile grid covering the box grown by the kernel radius; only touched tiles get cells.
+  const long r = kernel_radius_;
+  const auto floor_div = [](long a) { return a >= 0 ? a >> kTileShift : -((-a + kTileSize - 1) >> kTileShift); };
+  const long first_tile_x = floor_div(min_cx - r), last_tile_x = floor_div(max_cx + r);
+  const long first_tile_y = floor_div(min_cy - r), last_tile_y = floor_div(max_cy + r);
+  tiles_x_ = last_tile_x - first_tile_x + 1;
+  tiles_y_ = last_tile_y - first_tile_y + 1;
+  origin_cell_x_ = first_tile_x * kTileSize;
+  origin_cell_y_ = first_tile_y * kTileSize;
+  tile_index_.assign(static_cast<std::size_t>(tiles_x_ * tiles_y_), -1);
+
+  for (const auto& cell : cells) {
+    const long lx0 = cell.first - r - origin_cell_x_, lx1 = cell.first + r - origin_cell_x_;
+    const long ly0 = cell.second - r - origin_cell_y_, ly1 = cell.second + r - origin_cell_y_;
+    for (long ty = ly0 >> kTileShift; ty <= (ly1 >> kTileShift); ++ty) {
+      for (long tx = lx0 >> kTileShift; tx <= (lx1 >> kTileShift); ++tx) {
+        std::int32_t& index = tile_index_[ty * tiles_x_ + tx];
+        if (index < 0) index = static_cast<std::int32_t>(tiles_in_use_++);
+      }
+    }
+  }
+  tile_cells_.assign(tiles_in_use_ * kTileCells, 0);
+
+  // Stamp the kernel around each point, keeping the maximum (likelihood of the nearest point).
+  const long side = 2 * r + 1;
+  for (const auto& cell : cells) {
+    const long lx0 = cell.first - r - origin_cell_x_;
+    const long ly0 = cell.second - r - origin_cell_y_;
+    for (long ky = 0; ky < side; ++ky) {
+      const long ly = ly0 + ky;
+      const std::int32_t* index_row = &tile_index_[(ly >> kTileShift) * tiles_x_];
+      const std::uint8_t* kernel_row = &kernel_[ky * side];
+      const long cell_row = (ly & (kTileSize - 1)) << kTileShift;
+      for (long kx = 0; kx < side; ++kx) {
+        const std::uint8_t value = kernel_row[kx];
+        if (value == 0) continue;
+        const long lx = lx0 + kx;
+        std::uint8_t& target =
+            tile_cells_[static_cast<std::size_t>(index_row[lx >> kTileShift]) * kTileCells + cell_row +
+                        (lx & (kTileSize - 1))];
+        if (value > target) target = value;
+      }
+    }
+  }
+}
+
+std::uint8_t LookupTable::valueAt(const Eigen::Vector2d& point) const {
+  if (tiles_in_use_ == 0) return 0;
+  const double fx = point.x() * inv_cell_size_ - origin_cell_x_;
+  const double fy = point.y() * inv_cell_size_ - origin_cell_y_;
+  if (!(fx >= 0.0 && fy >= 0.0 && fx < tiles_x_ * kTileSize && fy < tiles_y_ * kTileSize)) return 0;
+  const long lx = static_cast<long>(fx), ly = static_cast<long>(fy);
+  const std::int32_t index = tile_index_[(ly >> kTileShift) * tiles_x_ + (lx >> kTileShift)];
+  if (index < 0) return 0;
+  return tile_cells_[static_cast<std::size_t>(index) * kTileCells + ((ly & (kTileSize - 1)) << kTileShift) +
+                     (lx & (kTileSize - 1))];
+}
+
+void FitnessPoints::assign(const std::vector<Eigen::Vector2d>& points) {
+  x.clear();
+  y.clear();
+  for (const auto& p : points) {
+    if (!p.allFinite()) continue;
+    x.push_back(static_cast<float>(p.x()));
+    y.push_back(static_cast<float>(p.y()));
+  }
+}
+
+std::uint32_t LookupTable::fitness(const std::vector<Eigen::Vector2d>& points, const Pose2D& pose) const {
+  FitnessPoints prepared;
+  prepared.assign(points);
+  return fitness(prepared, pose);
+}
+
+std::uint32_t LookupTable::fitness(const FitnessPoints& points, const Pose2D& pose) const {
+  if (tiles_in_use_ == 0 || !pose.isFinite()) return 0;
+  // One transform and one byte read per point. The cell scaling is folded into the transform, which runs
+  // in blocks the compiler vectorises; coordinates are clamped to [-1, size] first (NaN -> -1), so the
+  // integer conversion is always defined and one unsigned comparison per axis is the bounds check.
+  const float c = static_cast<float>(std::cos(pose.theta) * inv_cell_size_);
+  const float s = static_cast<float>(std::sin(pose.theta) * inv_cell_size_);
+  const float ox = static_cast<float>(pose.x * inv_cell_size_ - origin_cell_x_);
+  const float oy = static_cast<float>(pose.y * inv_cell_size_ - origin_cell_y_);
+  const std::uint32_t width = static_cast<std::uint32_t>(tiles_x_ * kTileSize);
+  const std::uint32_t height = static_cast<std::uint32_t>(tiles_y_ * kTileSize);
+  const float max_x = static_cast<float>(width), max_y = static_cast<float>(height);
+  const std::int32_t* index = tile_index_.data();
+  const std::uint8_t* cells = tile_cells_.data();
+  const long tiles_x = tiles_x_;
+
+  constexpr std::size_t kBlock = 64;
+  std::int32_t cell_x[kBlock], cell_y[kBlock];
+  std::uint32_t sum = 0;
+  const std::size_t n = points.size();
+  const float* px = points.x.data();
+  const float* py = points.y.data();
+  for (std::size_t begin = 0; begin < n; begin += kBlock) {
+    const std::size_t count = std::min(kBlock, n - begin);
+    for (std::size_t i = 0; i < count; ++i) {
+      const float fx = c * px[begin + i] - s * py[begin + i] + ox;
+      const float fy = s * px[begin + i] + c * py[begin + i] + oy;
+      cell_x[i] = static_cast<std::int32_t>(std::min(std::max(-1.0f, fx), max_x));
+      cell_y[i] = static_cast<std::int32_t>(std::min(std::max(-1.0f, fy), max_y));
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint32_t lx = static_cast<std::uint32_t>(cell_x[i]);
+      const std::uint32_t ly = static_cast<std::uint32_t>(cell_y[i]);
+      if (lx >= width || ly >= height) continue;
+      const std::int32_t tile = index[(ly >> kTileShift) * tiles_x + (lx >> kTileShift)];
+      if (tile < 0) continue;
+      sum += cells[static_cast<std::size_t>(tile) * kTileCells + ((ly & (kTileSize - 1)) << kTileShift) +
+                   (lx & (kTileSize - 1))];
+    }
+  }
+  return sum;
+}
+
+}  // namespace hglasm

@@ -1,0 +1,332 @@
+#include "hglasm_odometry/core/mbicp.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace hglasm {
+namespace {
+
+constexpr double kMinVariance = 1e-8;
+constexpr double kMaxVariance = 1e4;
+
+Eigen::Vector2d unitNormal(const Eigen::Vector2d& direction) {
+  const double length = direction.norm();
+  if (!(length > 0.0)) return Eigen::Vector2d::Zero();
+  return Eigen::Vector2d(-direction.y(), direction.x()) / length;
+}
+
+/// Squared metric-based distance between a new point p and a reference point q (the MbICP d_ap, with the
+/// rotation linearised): |p - q|^2 - ((p - q) x q)^2 / (|q|^2 + L^2).
+double dapSquared(const Eigen::Vector2d& p, const Eigen::Vector2d& q, double l_sq) {
+  const Eigen::Vector2d d = p - q;
+  const double cross = d.x() * q.y() - d.y() * q.x();
+  return d.squaredNorm() - cross * cross / (q.squaredNorm() + l_sq);
+}
+
+/// Clamps the eigenvalues of a symmetric matrix into [low, high].
+Eigen::Matrix3d clampEigenvalues(const Eigen::Matrix3d& matrix, double low, double high) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(matrix);
+  if (solver.info() != Eigen::Success || !solver.eigenvalues().allFinite()) {
+    return Eigen::Matrix3d::Identity() * high;
+  }
+  const Eigen::Vector3d clamped = solver.eigenvalues().cwiseMax(low).cwiseMin(high);
+  return solver.eigenvectors() * clamped.asDiagonal() * solver.eigenvectors().transpose();
+}
+
+}  // namespace
+
+const char* toString(MbicpStatus status) {
+  switch (status) {
+    case MbicpStatus::kConverged: return "converged";
+    case MbicpStatus::kMaxIterations: return "max_iterations";
+    case MbicpStatus::kTooFewAssociations: return "too_few_associations";
+    case MbicpStatus::kDegenerate: return "degenerate";
+  }
+  return "unknown";
+}
+
+Mbicp::Mbicp(const MbicpOptions& options) : options_(options) {}
+
+void Mbicp::setReference(const Scan& reference) {
+  ref_points_.clear();
+  for (const auto& p : reference.points) {
+    if (p.allFinite()) ref_points_.push_back(p);
+  }
+  const std::size_t n = ref_points_.size();
+  ref_has_next_.assign(n, 0);
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    const double range = std::min(ref_points_[i].norm(), ref_points_[i + 1].norm());
+    const double max_gap = options_.segment_max_gap + options_.segment_gap_per_metre * range;
+    ref_has_next_[i] = (ref_points_[i + 1] - ref_points_[i]).squaredNorm() < max_gap * max_gap ? 1 : 0;
+  }
+  ref_normals_.assign(n, Eigen::Vector2d::Zero());
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool has_prev = i > 0 && ref_has_next_[i - 1];
+    const bool has_next = ref_has_next_[i];
+    if (has_prev && has_next) {
+      ref_normals_[i] = unitNormal(ref_points_[i + 1] - ref_points_[i - 1]);
+    } else if (has_next) {
+      ref_normals_[i] = unitNormal(ref_points_[i + 1] - ref_points_[i]);
+    } else if (has_prev) {
+      ref_normals_[i] = unitNormal(ref_points_[i] - ref_points_[i - 1]);
+    }
+  }
+  sorted_index_.resize(n);
+  std::iota(sorted_index_.begin(), sorted_index_.end(), 0);
+  std::vector<double> bearing(n);
+  for (std::size_t i = 0; i < n; ++i) bearing[i] = std::atan2(ref_points_[i].y(), ref_points_[i].x());
+  std::sort(sorted_index_.begin(), sorted_index_.end(), [&](int a, int b) { return bearing[a] < bearing[b]; });
+  sorted_bearing_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
+}
+
+void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, std::vector<Association>* out) const {
+  out->clear();
+  const double l_sq = options_.metric_l * options_.metric_l;
+  const double gate_sq = options_.max_distance * options_.max_distance;
+  const double window = std::min(options_.bearing_window, M_PI);
+
+  for (const auto& p : moved) {
+    double best = gate_sq;
+    Association association;
+    bool found = false;
+
+    // Closest point of segment j -> j+1 under the metric, with the metric frozen at p (it varies slowly):
+    // minimise (a - t e)^T M (a - t e), M = I - u u^T / (|p|^2 + L^2), u = (p_y, -p_x).
+    const Eigen::Vector2d u(p.y(), -p.x());
+    const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
+    auto consider_point = [&](int j) {
+      const double d_sq = dapSquared(p, ref_points_[j], l_sq);
+      if (d_sq < best) {
+        best = d_sq, found = true;
+        association.target = ref_points_[j];
+        association.normal = ref_normals_[j];
+        association.on_segment = false;
+      }
+    };
+    auto consider_segment = [&](int j) {
+      const Eigen::Vector2d& q = ref_points_[j];
+      const Eigen::Vector2d e = ref_points_[j + 1] - q;
+      const Eigen::Vector2d a = p - q;
+      const double ue = u.dot(e), ua = u.dot(a);
+      const double eme = e.squaredNorm() - ue * ue * u_scale;
+      if (!(eme > 0.0)) return;
+      const double t = (e.dot(a) - ue * ua * u_scale) / eme;
+      if (t <= 0.0 || t >= 1.0) return;  // the end points are candidates of their own
+      const Eigen::Vector2d on_segment = q + t * e;
+      const double d_sq = dapSquared(p, on_segment, l_sq);
+      if (d_sq < best) {
+        best = d_sq, found = true;
+        association.target = on_segment;
+        association.normal = unitNormal(e);
+        association.on_segment = true;
+      }
+    };
+
+    // Walk outward in bearing from p's own bearing, both ways, within the window (wrapping at +-pi for
+    // 360-degree scans). A reference point at bearing offset D is at least |p| sin D away from p, and
+    // d_ap^2 >= |d|^2 L^2 / ((|p| + |d|)^2 + L^2), which grows with |d|: once that bound exceeds the
+    // best candidate so far, nothing farther in bearing can win, and the walk stops.
+    const double bearing = std::atan2(p.y(), p.x());
+    const double range = p.norm();
+    const int n = static_cast<int>(sorted_bearing_.size());
+    const int start = static_cast<int>(std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), bearing) -
+                                       sorted_bearing_.begin());
+    double reach = window;
+    double reach_best = -1.0;
+    auto update_reach = [&]() {
+      // Smallest |d| whose bound reaches `best`: root of d^2 (L^2 - best) - 2 best |p| d - best (|p|^2 + L^2).
+      reach_best = best;
+      const double denominator = l_sq - best;
+      if (!(denominator > 0.0) || !(range > 0.0)) {
+        reach = window;
+        return;
+      }
+      const double d_min = (best * range + std::sqrt(best * best * range * range + denominator * best * (range * range + l_sq))) /
+                           denominator;
+      reach = d_min >= range ? window : std::min(window, std::asin(d_min / range));
+    };
+    auto visit = [&](int j) {
+      consider_point(j);
+      if (ref_has_next_[j]) consider_segment(j);
+      if (j > 0 && ref_has_next_[j - 1]) consider_segment(j - 1);
+      // The reach from a larger `best` is still a valid (looser) bound: refresh only on a real gain.
+      if (best < 0.5 * reach_best) update_reach();
+    };
+    update_reach();
+    for (int step = 0; step < n; ++step) {  // counter-clockwise
+      int k = start + step;
+      double offset = (k >= n ? sorted_bearing_[k -= n] + 2.0 * M_PI : sorted_bearing_[k]) - bearing;
+      if (offset > reach) break;
+      visit(sorted_index_[k]);
+    }
+    for (int step = 1; step < n; ++step) {  // clockwise
+      int k = start - step;
+      double offset = bearing - (k < 0 ? sorted_bearing_[k += n] - 2.0 * M_PI : sorted_bearing_[k]);
+      if (offset > reach) break;
+      visit(sorted_index_[k]);
+    }
+
+    if (found) {
+      association.point = p;
+      association.distance_sq = std::max(0.0, best);
+      out->push_back(association);
+    }
+  }
+}
+
+MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
+  MbicpResult result;
+  result.pose = initial.isFinite() ? initial : Pose2D();
+  result.covariance = Eigen::Matrix3d::Identity() * kMaxVariance;
+
+  std::vector<Eigen::Vector2d> points;
+  points.reserve(scan.points.size());
+  for (const auto& p : scan.points) {
+    if (p.allFinite()) points.push_back(p);
+  }
+  const std::size_t min_associations =
+      std::max<std::size_t>(3, static_cast<std::size_t>(std::ceil(options_.min_association_ratio * points.size())));
+  if (ref_points_.empty() || points.size() < 3) {
+    result.status = MbicpStatus::kTooFewAssociations;
+    return result;
+  }
+
+  const double l_sq = options_.metric_l * options_.metric_l;
+  double previous_error = -1.0;
+  int quiet_iterations = 0;
+  result.status = MbicpStatus::kMaxIterations;
+  moved_.resize(points.size());
+
+  for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
+    result.iterations = iteration;
+    const double c = std::cos(result.pose.theta), s = std::sin(result.pose.theta);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      moved_[i] = Eigen::Vector2d(c * points[i].x() - s * points[i].y() + result.pose.x,
+                                  s * points[i].x() + c * points[i].y() + result.pose.y);
+    }
+    associate(moved_, &associations_);
+    if (associations_.size() < min_associations) {
+      result.status = MbicpStatus::kTooFewAssociations;
+      result.associations = static_cast<int>(associations_.size());
+      return result;
+    }
+    // Trimming: the worst associations (outliers, unmatched structure) do not vote.
+    const std::size_t keep = std::max(
+        min_associations, static_cast<std::size_t>(std::ceil(options_.trim_fraction * associations_.size())));
+    if (keep < associations_.size()) {
+      std::nth_element(associations_.begin(), associations_.begin() + keep, associations_.end(),
+                       [](const Association& a, const Association& b) { return a.distance_sq < b.distance_sq; });
+      associations_.resize(keep);
+    }
+
+    // Closed-form step: minimise sum (r + J q)^T M (r + J q) over the increment q = (x, y, theta), with
+    // the point moved by the linearised rotation (J = [1 0 -p_y; 0 1 p_x]) and M the d_ap metric at the target.
+    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    double error = 0.0;
+    for (const auto& assoc : associations_) {
+      const Eigen::Vector2d& p = assoc.point;
+      const Eigen::Vector2d& c = assoc.target;
+      const Eigen::Vector2d u(c.y(), -c.x());
+      Eigen::Matrix2d m = Eigen::Matrix2d::Identity() - u * u.transpose() / (c.squaredNorm() + l_sq);
+      if (options_.point_to_line && assoc.on_segment) {
+        // Distance to the line under the metric: remove the metric-weighted tangent direction.
+        const Eigen::Vector2d tangent(assoc.normal.y(), -assoc.normal.x());
+        const Eigen::Vector2d m_tangent = m * tangent;
+        m -= m_tangent * m_tangent.transpose() / tangent.dot(m_tangent);
+      }
+      Eigen::Matrix<double, 2, 3> jacobian;
+      jacobian << 1.0, 0.0, -p.y(), 0.0, 1.0, p.x();
+      const Eigen::Matrix<double, 3, 2> jt_m = jacobian.transpose() * m;
+      a += jt_m * jacobian;
+      b += jt_m * (p - c);
+      error += assoc.distance_sq;
+    }
+    error /= static_cast<double>(associations_.size());
+    result.associations = static_cast<int>(associations_.size());
+    result.rms_error = std::sqrt(error);
+
+    // A whisker of damping keeps directions no association constrains (a straight wall) at zero step.
+    a.diagonal() += Eigen::Vector3d::Constant(1e-9 * a.trace() + 1e-12);
+    const Eigen::Vector3d step = a.ldlt().solve(-b);
+    if (!step.allFinite()) {
+      result.status = MbicpStatus::kDegenerate;
+      break;
+    }
+    result.pose = Pose2D(step.x(), step.y(), step.z()) * result.pose;
+
+    const bool small_step = std::abs(step.x()) < options_.min_step_xy && std::abs(step.y()) < options_.min_step_xy &&
+                            std::abs(step.z()) < options_.min_step_theta;
+    const bool no_progress =
+        previous_error >= 0.0 && std::abs(previous_error - error) <= options_.error_ratio * std::max(error, 1e-12);
+    quiet_iterations = (small_step || no_progress) ? quiet_iterations + 1 : 0;
+    previous_error = error;
+    if (quiet_iterations >= options_.converged_iterations) {
+      result.status = MbicpStatus::kConverged;
+      break;
+    }
+  }
+
+  // Uncertainty from point-to-line information: only the component of each residual along the reference
+  // normal is informative (a point may slide along a wall), so a corridor shows its unconstrained axis.
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  double residual_sq = 0.0;
+  int constraints = 0;
+  for (const auto& assoc : associations_) {
+    if (assoc.normal.isZero()) continue;
+    const Eigen::Vector2d& p = assoc.point;  // in the reference frame, as the increments are
+    const Eigen::Vector3d row(assoc.normal.x(), assoc.normal.y(), assoc.normal.y() * p.x() - assoc.normal.x() * p.y());
+    information += row * row.transpose();
+    const double r = assoc.normal.dot(assoc.point - assoc.target);
+    residual_sq += r * r;
+    ++constraints;
+  }
+  if (constraints > 3) {
+    // Noise floor of 1 cm: residuals of a noise-free or perfectly interleaved pair are not zero-uncertainty.
+    const double variance = std::max(residual_sq / (constraints - 3), 1e-4);
+    // Degeneracy test in consistent units: scale the rotation by the mean point radius.
+    double radius = 0.0;
+    for (const auto& assoc : associations_) radius += assoc.point.norm();
+    radius = std::max(radius / associations_.size(), 1e-3);
+    Eigen::Matrix3d scaled = information;
+    scaled.row(2) /= radius;
+    scaled.col(2) /= radius;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scaled);
+    const Eigen::Vector3d eigenvalues = solver.eigenvalues();
+    // The information is of an increment applied in the reference frame (pose = delta * estimate);
+    // G maps that increment to the pose's own (x, y, theta).
+    Eigen::Matrix3d to_pose = Eigen::Matrix3d::Identity();
+    to_pose(0, 2) = -result.pose.y;
+    to_pose(1, 2) = result.pose.x;
+    const bool degenerate = !(eigenvalues.minCoeff() > options_.degenerate_eigenvalue * eigenvalues.maxCoeff());
+    if (degenerate) {
+      result.status = MbicpStatus::kDegenerate;
+      // Pseudo-inverse of the scaled information: the unconstrained direction gets the maximum variance.
+      Eigen::Vector3d inverse_eigen;
+      for (int i = 0; i < 3; ++i) {
+        inverse_eigen[i] = eigenvalues[i] > options_.degenerate_eigenvalue * eigenvalues.maxCoeff()
+                               ? variance / eigenvalues[i]
+                               : kMaxVariance;
+      }
+      Eigen::Matrix3d cov_scaled = solver.eigenvectors() * inverse_eigen.asDiagonal() * solver.eigenvectors().transpose();
+      cov_scaled.row(2) /= radius;
+      cov_scaled.col(2) /= radius;
+      result.covariance = clampEigenvalues(to_pose * cov_scaled * to_pose.transpose(), kMinVariance, kMaxVariance);
+    } else {
+      result.covariance = clampEigenvalues(to_pose * (variance * information.inverse()) * to_pose.transpose(),
+                                           kMinVariance, kMaxVariance);
+    }
+  } else {
+    result.status = MbicpStatus::kTooFewAssociations;
+  }
+  if (!result.pose.isFinite()) {
+    result.pose = initial.isFinite() ? initial : Pose2D();
+    result.status = MbicpStatus::kDegenerate;
+  }
+  return result;
+}
+
+}  // namespace hglasm

@@ -1,0 +1,231 @@
+#include "hglasm_odometry/core/odometry_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace hglasm {
+namespace {
+
+constexpr double kMaxVariance = 1e4;
+constexpr double kMinVelocityDt = 1e-3;  // seconds: scans closer than this do not update the velocity
+
+/// Covariance of a ⊕ b from the covariances of a (parent frame) and b (a's frame), first order.
+Eigen::Matrix3d composeCovariance(const Pose2D& a, const Eigen::Matrix3d& cov_a, const Pose2D& b,
+                                  const Eigen::Matrix3d& cov_b) {
+  const Pose2D ab = a * b;
+  Eigen::Matrix3d j_a = Eigen::Matrix3d::Identity();
+  j_a(0, 2) = -(ab.y - a.y);
+  j_a(1, 2) = ab.x - a.x;
+  Eigen::Matrix3d j_b = Eigen::Matrix3d::Identity();
+  const double c = std::cos(a.theta), s = std::sin(a.theta);
+  j_b.topLeftCorner<2, 2>() << c, -s, s, c;
+  Eigen::Matrix3d cov = j_a * cov_a * j_a.transpose() + j_b * cov_b * j_b.transpose();
+  cov = 0.5 * (cov + cov.transpose());
+  return cov.cwiseMin(kMaxVariance).cwiseMax(-kMaxVariance);
+}
+
+/// Covariance of a laser motion L re-expressed for the base motion B = M ⊕ L ⊕ M^-1 (first order):
+/// dB_t/dL_t = R_M, dB_t/dL_theta = -S R_L t_M (S = 90-degree rotation), dB_theta/dL_theta = 1.
+Eigen::Matrix3d laserToBaseCovariance(const Pose2D& mount, const Pose2D& laser_motion, const Eigen::Matrix3d& cov) {
+  const double cm = std::cos(mount.theta), sm = std::sin(mount.theta);
+  const double cl = std::cos(laser_motion.theta), sl = std::sin(laser_motion.theta);
+  const Eigen::Vector2d rotated_lever(cl * mount.x - sl * mount.y, sl * mount.x + cl * mount.y);
+  Eigen::Matrix3d jacobian = Eigen::Matrix3d::Identity();
+  jacobian.topLeftCorner<2, 2>() << cm, -sm, sm, cm;
+  jacobian(0, 2) = rotated_lever.y();
+  jacobian(1, 2) = -rotated_lever.x();
+  return jacobian * cov * jacobian.transpose();
+}
+
+Eigen::Matrix3d odometryNoise(const TrackerOptions& options, const Pose2D& motion) {
+  const double sigma_xy = options.odometry_noise_xy * motion.translationNorm() + 0.01;
+  const double sigma_theta = options.odometry_noise_theta * std::abs(motion.theta) + 0.005;
+  return Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_theta * sigma_theta).asDiagonal();
+}
+
+}  // namespace
+
+const char* toString(PredictionSource source) {
+  switch (source) {
+    case PredictionSource::kOdometry: return "odometry";
+    case PredictionSource::kConstantVelocity: return "constant_velocity";
+    case PredictionSource::kNone: return "none";
+  }
+  return "unknown";
+}
+
+OdometryTracker::OdometryTracker(const TrackerOptions& options) : options_(options), matcher_(options.matcher) {}
+
+void OdometryTracker::setLaserMount(const Pose2D& base_to_laser) {
+  if (base_to_laser.isFinite()) laser_mount_ = base_to_laser;
+}
+
+void OdometryTracker::addOdometry(double stamp, const Pose2D& odom_pose) { odometry_.add(stamp, odom_pose); }
+
+void OdometryTracker::reset() {
+  initialised_ = false;
+  has_keyframe_ = false;
+  pose_ = Pose2D();
+  pose_covariance_.setZero();
+  velocity_.setZero();
+  velocity_valid_ = false;
+}
+
+PredictionSource OdometryTracker::predict(double stamp, Pose2D* predicted, std::string* warning) const {
+  const double dt = stamp - last_stamp_;
+  if (options_.use_odometry) {
+    Pose2D odom_last, odom_now;
+    const double reach = options_.odometry_max_extrapolation;
+    if (odometry_.poseAt(last_stamp_, reach, &odom_last) && odometry_.poseAt(stamp, reach, &odom_now)) {
+      const Pose2D motion = relativePose(odom_last, odom_now);
+      const bool plausible = motion.translationNorm() <= options_.max_odometry_speed * dt + 0.2 &&
+                             std::abs(motion.theta) <= options_.max_odometry_turn_rate * dt + 0.2;
+      if (plausible) {
+        *predicted = pose_ * motion;
+        return PredictionSource::kOdometry;
+      }
+      std::ostringstream text;
+      text << "wheel odometry jumped " << motion.translationNorm() << " m / " << motion.theta << " rad in " << dt
+           << " s; using the constant-velocity prediction";
+      *warning = text.str();
+    }
+  }
+  if (velocity_valid_) {
+    *predicted = pose_ * Pose2D(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
+    return PredictionSource::kConstantVelocity;
+  }
+  *predicted = pose_;
+  return PredictionSource::kNone;
+}
+
+void OdometryTracker::setKeyframe(double stamp, const Scan& scan, const Pose2D& pose,
+                                  const Eigen::Matrix3d& covariance) {
+  matcher_.setReference(scan);
+  has_keyframe_ = matcher_.hasReference();
+  keyframe_requested_ = false;
+  keyframe_stamp_ = stamp;
+  keyframe_pose_ = pose;
+  keyframe_covariance_ = covariance;
+  keyframe_beam_count_ = scan.beam_count;
+  ++keyframe_id_;
+}
+
+TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::vector<Pose2D>* population_out) {
+  TrackerUpdate update;
+  update.stamp = stamp;
+  if (population_out) population_out->clear();
+  if (!std::isfinite(stamp)) {
+    update.warning = "scan stamp is not finite; scan ignored";
+    update.pose = pose_;
+    update.pose_covariance = pose_covariance_;
+    return update;
+  }
+
+  if (initialised_) {
+    const double dt = stamp - last_stamp_;
+    if (dt < 0.0 || dt > options_.max_time_jump) {
+      std::ostringstream text;
+      text << "scan time " << (dt < 0.0 ? "went back" : "jumped forward") << " by " << std::abs(dt)
+           << " s; odometry reset to the origin";
+      update.warning = text.str();
+      reset();
+    }
+  }
+
+  const bool usable = static_cast<int>(scan.size()) >= options_.min_points;
+  if (!initialised_) {
+    initialised_ = true;
+    last_stamp_ = stamp;
+    update.reset = true;
+    update.published = true;
+    update.pose = pose_;
+    update.pose_covariance = pose_covariance_;
+    if (usable) {
+      setKeyframe(stamp, scan, pose_, pose_covariance_);
+      update.new_keyframe = true;
+    }
+    update.keyframe_id = keyframe_id_;
+    return update;
+  }
+
+  const double dt = stamp - last_stamp_;
+  Pose2D predicted;
+  std::string prediction_warning;
+  update.prediction = predict(stamp, &predicted, &prediction_warning);
+  if (update.warning.empty()) update.warning = prediction_warning;
+  update.guess = predicted;
+  const Pose2D predicted_step = relativePose(pose_, predicted);
+
+  Pose2D new_pose = predicted;
+  Eigen::Matrix3d new_covariance =
+      composeCovariance(pose_, pose_covariance_, predicted_step, odometryNoise(options_, predicted_step));
+  Eigen::Matrix3d step_covariance = odometryNoise(options_, predicted_step) * options_.fallback_covariance_scale;
+
+  if (has_keyframe_ && usable) {
+    // Guess of the new laser pose in the keyframe's laser frame: conjugate the base motion by the mount.
+    const Pose2D base_motion = relativePose(keyframe_pose_, predicted);
+    const Pose2D laser_guess = laser_mount_.inverse() * base_motion * laser_mount_;
+    std::vector<Pose2D>* population = population_out;
+    update.match = matcher_.match(scan, laser_guess, population);
+    update.matched = true;
+    const bool match_ok = (update.match.status == MatchStatus::kOk ||
+                           update.match.status == MatchStatus::kMbicpNotConverged) &&
+                          update.match.fitness_ratio >= options_.min_fitness && update.match.pose.isFinite();
+    if (match_ok) {
+      const Pose2D base_estimate = laser_mount_ * update.match.pose * laser_mount_.inverse();
+      const Eigen::Matrix3d base_cov = laserToBaseCovariance(laser_mount_, update.match.pose, update.match.covariance);
+      new_pose = keyframe_pose_ * base_estimate;
+      new_covariance = composeCovariance(keyframe_pose_, keyframe_covariance_, base_estimate, base_cov);
+      step_covariance = base_cov;
+    } else {
+      update.fallback = true;
+    }
+    if (population_out) {
+      for (auto& pose : *population_out) pose = keyframe_pose_ * (laser_mount_ * pose * laser_mount_.inverse());
+    }
+  } else {
+    update.fallback = true;  // nothing to match against (or nothing to match): keep the motion predicted
+    update.match.status = has_keyframe_ ? MatchStatus::kTooFewPoints : MatchStatus::kNoReference;
+  }
+  if (update.fallback) new_covariance += step_covariance;
+
+  if (dt > kMinVelocityDt) {
+    const Pose2D step = relativePose(pose_, new_pose);
+    velocity_ = Eigen::Vector3d(step.x, step.y, step.theta) / dt;
+    velocity_valid_ = true;
+    update.velocity_covariance = (step_covariance / (dt * dt)).cwiseMin(kMaxVariance).cwiseMax(-kMaxVariance);
+  } else {
+    update.velocity_covariance = Eigen::Matrix3d::Identity() * kMaxVariance;
+  }
+
+  pose_ = new_pose;
+  pose_covariance_ = new_covariance;
+  last_stamp_ = stamp;
+
+  // A new reference when the robot has moved away from the keyframe, when the match was poor or failed
+  // (the old reference no longer explains the scene), or when the scanner changed.
+  const Pose2D since_keyframe = relativePose(keyframe_pose_, pose_);
+  const bool geometry_changed = has_keyframe_ && scan.beam_count != keyframe_beam_count_;
+  if (geometry_changed && update.warning.empty()) {
+    update.warning = "scan beam count changed from " + std::to_string(keyframe_beam_count_) + " to " +
+                     std::to_string(scan.beam_count) + "; new keyframe";
+  }
+  const bool wants_keyframe = !has_keyframe_ || keyframe_requested_ || geometry_changed || update.fallback ||
+                              since_keyframe.translationNorm() > options_.keyframe_distance ||
+                              std::abs(since_keyframe.theta) > options_.keyframe_angle ||
+                              (update.matched && update.match.fitness_ratio < options_.keyframe_min_fitness);
+  if (wants_keyframe && usable) {
+    setKeyframe(stamp, scan, pose_, pose_covariance_);
+    update.new_keyframe = true;
+  }
+
+  update.published = true;
+  update.pose = pose_;
+  update.pose_covariance = pose_covariance_;
+  update.velocity = velocity_;
+  update.keyframe_id = keyframe_id_;
+  return update;
+}
+
+}  // namespace hglasm

@@ -1,0 +1,73 @@
+#include "hglasm_odometry/core/scan.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hglasm {
+
+const char* toString(ScanError error) {
+  switch (error) {
+    case ScanError::kNone: return "ok";
+    case ScanError::kNoBeams: return "scan has no beams";
+    case ScanError::kBadAngles: return "angle_min or angle_increment is not finite, or the increment is zero";
+    case ScanError::kBadRangeLimits: return "range_min/range_max are NaN or range_max < range_min";
+  }
+  return "unknown";
+}
+
+Scan scanFromRanges(const RangeScan& input, const ScanConversionOptions& options, ScanError* error) {
+  Scan scan;
+  scan.beam_count = static_cast<int>(input.ranges.size());
+  ScanError status = ScanError::kNone;
+  if (input.ranges.empty()) {
+    status = ScanError::kNoBeams;
+  } else if (!std::isfinite(input.angle_min) || !std::isfinite(input.angle_increment) ||
+             (input.ranges.size() > 1 && input.angle_increment == 0.0)) {
+    status = ScanError::kBadAngles;
+  } else if (std::isnan(input.range_min) || std::isnan(input.range_max) || input.range_max < input.range_min) {
+    status = ScanError::kBadRangeLimits;
+  }
+  if (error) *error = status;
+  if (status != ScanError::kNone) {
+    scan.invalid_count = scan.beam_count;
+    return scan;
+  }
+
+  const double lower = std::max({input.range_min, options.min_range, 0.0});
+  const double upper = std::min(input.range_max, options.max_range);
+  const int step = std::max(1, options.beam_step);
+  const double sign = options.mirror ? -1.0 : 1.0;
+  scan.points.reserve(input.ranges.size() / step + 1);
+  scan.beam_index.reserve(input.ranges.size() / step + 1);
+  for (int i = 0; i < scan.beam_count; i += step) {
+    const double range = input.ranges[i];
+    // REP-117: NaN, +-inf and out-of-limit readings carry no position; zero is never a return.
+    if (!std::isfinite(range) || range <= 0.0 || range < lower || range > upper) continue;
+    const double angle = sign * (input.angle_min + i * input.angle_increment);
+    scan.points.emplace_back(range * std::cos(angle), range * std::sin(angle));
+    scan.beam_index.push_back(i);
+  }
+  scan.invalid_count = scan.beam_count - static_cast<int>(scan.points.size());
+  return scan;
+}
+
+Scan selectBeams(const Scan& scan, int parity) {
+  Scan out;
+  out.beam_count = scan.beam_count;
+  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+    if ((scan.beam_index[i] & 1) == (parity & 1)) {
+      out.points.push_back(scan.points[i]);
+      out.beam_index.push_back(scan.beam_index[i]);
+    }
+  }
+  out.invalid_count = 0;
+  return out;
+}
+
+Scan transformScan(const Scan& scan, const Pose2D& pose) {
+  Scan out = scan;
+  for (auto& point : out.points) point = pose * point;
+  return out;
+}
+
+}  // namespace hglasm
