@@ -82,10 +82,10 @@ void Mbicp::setReference(const Scan& reference) {
   for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
 }
 
-void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, std::vector<Association>* out) const {
+void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) const {
   out->clear();
   const double l_sq = options_.metric_l * options_.metric_l;
-  const double gate_sq = options_.max_distance * options_.max_distance;
+  const double gate_sq = gate * gate;
   const double window = std::min(options_.bearing_window, M_PI);
 
   for (const auto& p : moved) {
@@ -197,6 +197,8 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
   const double l_sq = options_.metric_l * options_.metric_l;
   double previous_error = -1.0;
   int quiet_iterations = 0;
+  const double fine_gate = options_.fine_max_distance > 0.0 ? options_.fine_max_distance : options_.max_distance;
+  bool settled = fine_gate == options_.max_distance;
   result.status = MbicpStatus::kMaxIterations;
   moved_.resize(points.size());
 
@@ -207,7 +209,7 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
       moved_[i] = Eigen::Vector2d(c * points[i].x() - s * points[i].y() + result.pose.x,
                                   s * points[i].x() + c * points[i].y() + result.pose.y);
     }
-    associate(moved_, &associations_);
+    associate(moved_, settled ? fine_gate : options_.max_distance, &associations_);
     if (associations_.size() < min_associations) {
       result.status = MbicpStatus::kTooFewAssociations;
       result.associations = static_cast<int>(associations_.size());
@@ -258,6 +260,13 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
     }
     result.pose = Pose2D(step.x(), step.y(), step.z()) * result.pose;
 
+    if (!settled) {
+      // Wide gate until the estimate settles; convergence is only judged under the fine gate.
+      settled = std::abs(step.x()) < options_.settle_step_xy && std::abs(step.y()) < options_.settle_step_xy &&
+                std::abs(step.z()) < options_.settle_step_theta;
+      previous_error = -1.0;
+      continue;
+    }
     const bool small_step = std::abs(step.x()) < options_.min_step_xy && std::abs(step.y()) < options_.min_step_xy &&
                             std::abs(step.z()) < options_.min_step_theta;
     const bool no_progress =

@@ -19,16 +19,26 @@ double OdometryBuffer::newestStamp() const { return samples_.empty() ? 0.0 : sam
 
 bool OdometryBuffer::poseAt(double stamp, double max_extrapolation, Pose2D* pose) const {
   if (samples_.empty() || !std::isfinite(stamp)) return false;
-  // Outside the buffered span hold the nearest sample (for at most max_extrapolation seconds):
-  // extrapolating from odometry samples that are often < 1 ms apart would amplify their noise.
+  // Before the buffered span hold the oldest sample (for at most max_extrapolation seconds).
   if (stamp <= samples_.front().stamp) {
     if (samples_.front().stamp - stamp > max_extrapolation) return false;
     *pose = samples_.front().pose;
     return true;
   }
   if (stamp >= samples_.back().stamp) {
-    if (stamp - samples_.back().stamp > max_extrapolation) return false;
-    *pose = samples_.back().pose;
+    const Sample& newest = samples_.back();
+    const double ahead = stamp - newest.stamp;
+    if (ahead > max_extrapolation) return false;
+    // Extrapolate with the odometry's own velocity, measured over at least kMinVelocityBaseline: samples
+    // often come in pairs < 1 ms apart, whose difference is noise, not velocity.
+    for (auto it = samples_.rbegin() + 1; it != samples_.rend(); ++it) {
+      const double baseline = newest.stamp - it->stamp;
+      if (baseline < kMinVelocityBaseline) continue;
+      if (baseline > kMaxVelocityBaseline) break;
+      *pose = interpolate(it->pose, newest.pose, 1.0 + ahead / baseline);
+      return true;
+    }
+    *pose = newest.pose;  // no usable baseline: hold
     return true;
   }
   const auto upper = std::upper_bound(samples_.begin(), samples_.end(), stamp,

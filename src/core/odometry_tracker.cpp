@@ -8,7 +8,10 @@ namespace hglasm {
 namespace {
 
 constexpr double kMaxVariance = 1e4;
-constexpr double kMinVelocityDt = 1e-3;  // seconds: scans closer than this do not update the velocity
+// The velocity is the motion over the last kVelocityBaseline seconds or more: some logs hold bursts of
+// scans ~1 ms apart whose stamps do not match their motion, and a per-step velocity would explode.
+constexpr double kVelocityBaseline = 0.1;  // seconds
+constexpr double kMaxVelocityAge = 2.0;    // seconds: older motion says nothing about the current speed
 
 /// Covariance of a ⊕ b from the covariances of a (parent frame) and b (a's frame), first order.
 Eigen::Matrix3d composeCovariance(const Pose2D& a, const Eigen::Matrix3d& cov_a, const Pose2D& b,
@@ -70,6 +73,7 @@ void OdometryTracker::reset() {
   pose_covariance_.setZero();
   velocity_.setZero();
   velocity_valid_ = false;
+  history_.clear();
 }
 
 PredictionSource OdometryTracker::predict(double stamp, Pose2D* predicted, std::string* warning) const {
@@ -137,6 +141,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
   if (!initialised_) {
     initialised_ = true;
     last_stamp_ = stamp;
+    history_.push_back(StampedPose{stamp, pose_});
     update.reset = true;
     update.published = true;
     update.pose = pose_;
@@ -149,7 +154,6 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
     return update;
   }
 
-  const double dt = stamp - last_stamp_;
   Pose2D predicted;
   std::string prediction_warning;
   update.prediction = predict(stamp, &predicted, &prediction_warning);
@@ -190,12 +194,22 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
   }
   if (update.fallback) new_covariance += step_covariance;
 
-  if (dt > kMinVelocityDt) {
-    const Pose2D step = relativePose(pose_, new_pose);
-    velocity_ = Eigen::Vector3d(step.x, step.y, step.theta) / dt;
+  // Velocity over a baseline of at least kVelocityBaseline seconds, capped at the plausible speeds.
+  history_.push_back(StampedPose{stamp, new_pose});
+  while (history_.size() > 2 && stamp - history_[1].stamp >= kVelocityBaseline) history_.pop_front();
+  const double baseline = stamp - history_.front().stamp;
+  if (baseline >= kVelocityBaseline && baseline <= kMaxVelocityAge) {
+    const Pose2D motion = relativePose(history_.front().pose, new_pose);
+    Eigen::Vector3d velocity(motion.x / baseline, motion.y / baseline, motion.theta / baseline);
+    const double speed = velocity.head<2>().norm();
+    if (speed > options_.max_odometry_speed) velocity.head<2>() *= options_.max_odometry_speed / speed;
+    velocity.z() = std::clamp(velocity.z(), -options_.max_odometry_turn_rate, options_.max_odometry_turn_rate);
+    velocity_ = velocity;
     velocity_valid_ = true;
-    update.velocity_covariance = (step_covariance / (dt * dt)).cwiseMin(kMaxVariance).cwiseMax(-kMaxVariance);
+    update.velocity_covariance =
+        (step_covariance / (baseline * baseline)).cwiseMin(kMaxVariance).cwiseMax(-kMaxVariance);
   } else {
+    if (baseline > kMaxVelocityAge) velocity_valid_ = false;
     update.velocity_covariance = Eigen::Matrix3d::Identity() * kMaxVariance;
   }
 

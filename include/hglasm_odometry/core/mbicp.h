@@ -13,7 +13,12 @@ namespace hglasm {
 struct MbicpOptions {
   double metric_l = 3.0;              ///< L of the metric, metres
   double bearing_window = 0.52;       ///< radians: candidate reference points lie within this bearing
-  double max_distance = 0.30;         ///< metres: association gate on d_ap
+  double max_distance = 0.30;         ///< metres: association gate on d_ap while the estimate moves
+  /// metres: the gate once steps fall below settle_step_xy / settle_step_theta (the estimate has settled):
+  /// the last iterations ignore moved objects and unmatched structure. <= 0: keep max_distance.
+  double fine_max_distance = 0.15;
+  double settle_step_xy = 0.01;       ///< metres
+  double settle_step_theta = 0.005;   ///< radians
   /// Consecutive reference points form a segment if they are closer than
   /// segment_max_gap + segment_gap_per_metre * range (beams diverge with range).
   double segment_max_gap = 0.30;      ///< metres
@@ -70,7 +75,7 @@ class Mbicp {
     bool on_segment;         // target lies inside a reference segment (normal = the segment's)
     double distance_sq;      // d_ap^2
   };
-  void associate(const std::vector<Eigen::Vector2d>& moved, std::vector<Association>* out) const;
+  void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) const;
 
   MbicpOptions options_;
   std::vector<Eigen::Vector2d> ref_points_;  // in beam order

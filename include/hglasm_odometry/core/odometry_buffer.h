@@ -15,8 +15,10 @@ class OdometryBuffer {
   /// Adds a sample. Out-of-order samples are inserted in place; non-finite ones are rejected (false).
   bool add(double stamp, const Pose2D& pose);
 
-  /// Pose at `stamp`, interpolated between the two samples around it. Outside the buffered span it
-  /// holds the nearest sample for at most `max_extrapolation` seconds; beyond, false.
+  /// Pose at `stamp`, interpolated between the two samples around it. After the newest sample it
+  /// extrapolates with the velocity over the last 0.05-1 s of samples (holds the newest sample if there is
+  /// no such baseline), before the oldest it holds the oldest; at most `max_extrapolation` seconds, else
+  /// false.
   bool poseAt(double stamp, double max_extrapolation, Pose2D* pose) const;
 
   double newestStamp() const;
@@ -29,6 +31,8 @@ class OdometryBuffer {
     double stamp;
     Pose2D pose;
   };
+  static constexpr double kMinVelocityBaseline = 0.05;  // seconds
+  static constexpr double kMaxVelocityBaseline = 1.0;   // seconds
   double max_age_;  // seconds kept behind the newest sample
   std::deque<Sample> samples_;
 };

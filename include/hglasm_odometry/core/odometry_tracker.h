@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,7 @@ class OdometryTracker {
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
   bool velocity_valid_ = false;
 
+  std::deque<StampedPose> history_;  // recent poses, for the velocity
   bool has_keyframe_ = false;
   bool keyframe_requested_ = false;
   int keyframe_id_ = 0;

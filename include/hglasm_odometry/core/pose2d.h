@@ -30,6 +30,12 @@ struct Pose2D {
   bool isFinite() const { return std::isfinite(x) && std::isfinite(y) && std::isfinite(theta); }
 };
 
+/// A pose at a time (seconds).
+struct StampedPose {
+  double stamp = 0.0;
+  Pose2D pose;
+};
+
 /// a^-1 * b: the pose of b expressed in a's frame.
 Pose2D relativePose(const Pose2D& a, const Pose2D& b);
 

@@ -18,11 +18,6 @@ struct Relation {
 /// Reads `t1 t2 x y z roll pitch yaw` lines (z, roll, pitch ignored). False with *error on failure.
 bool readRelations(const std::string& path, std::vector<Relation>* relations, std::string* error);
 
-struct StampedPose {
-  double stamp = 0.0;
-  Pose2D pose;
-};
-
 struct RelationStats {
   int count = 0;             ///< relations evaluated
   int missing = 0;           ///< relations whose stamps are not in the trajectory
