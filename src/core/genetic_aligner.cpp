@@ -29,7 +29,7 @@ class Codec {
 
   int totalBits() const { return 3 * bits_; }
 
-  /// The offset from the centre is applied in the guess's frame: the box is aligned with the guess.
+  /// The box is centred on the guess and aligned with the reference frame's axes.
   Pose2D decode(std::uint64_t chromosome) const {
     double offset[3];
     for (int gene = 0; gene < 3; ++gene) {
@@ -170,7 +170,7 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
     }
   }
 
-  polish(table, points, &result);
+  polish(table, points, guess, &result);
 
   if (population_out) {
     population_out->clear();
@@ -181,8 +181,13 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
   return result;
 }
 
-void GeneticAligner::polish(const LookupTable& table, const FitnessPoints& points,
+void GeneticAligner::polish(const LookupTable& table, const FitnessPoints& points, const Pose2D& guess,
                             PreAlignResult* result) const {
+  // Candidates stay inside the search box around the guess, like every GA individual.
+  const auto inside_box = [&](const Pose2D& pose) {
+    return std::abs(pose.x - guess.x) <= options_.box.half_x && std::abs(pose.y - guess.y) <= options_.box.half_y &&
+           std::abs(normalizeAngle(pose.theta - guess.theta)) <= options_.box.half_theta;
+  };
   // Compass search: try +-step on each axis, move to the first improvement, halve the steps when none.
   const double cell = table.options().cell_size;
   double step_xy = 4.0 * cell;
@@ -196,6 +201,7 @@ void GeneticAligner::polish(const LookupTable& table, const FitnessPoints& point
     for (const Pose2D& move : moves) {
       if (budget-- <= 0) break;
       const Pose2D candidate(centre.x + move.x, centre.y + move.y, centre.theta + move.theta);
+      if (!inside_box(candidate)) continue;
       const std::uint32_t fitness = table.fitness(points, candidate);
       ++result->evaluations;
       if (fitness > result->fitness) {

@@ -73,7 +73,40 @@ void OdometryTracker::reset() {
   pose_covariance_.setZero();
   velocity_.setZero();
   velocity_valid_ = false;
+  recent_fitness_ = 0.0;
   history_.clear();
+}
+
+void OdometryTracker::guardAgainstJump(const Scan& scan, const Pose2D& laser_guess, PredictionSource prediction,
+                                       TrackerUpdate* update) {
+  if (prediction == PredictionSource::kNone || !usesGeneticStage(options_.matcher.algorithm)) return;
+  // The guess relative to the keyframe is the predicted motion since the keyframe.
+  const auto far_from_guess = [&](const Pose2D& pose) {
+    const Pose2D deviation = relativePose(laser_guess, pose);
+    return deviation.translationNorm() > options_.jump_distance + options_.jump_fraction * laser_guess.translationNorm() ||
+           std::abs(deviation.theta) > options_.jump_angle + options_.jump_fraction * std::abs(laser_guess.theta);
+  };
+  if (!far_from_guess(update->match.pose)) return;
+  const double jump_fitness = matcher_.fitnessRatioAt(scan, update->match.pose);
+  const MatchResult from_guess = matcher_.refine(scan, laser_guess);
+  const bool guess_refined = (from_guess.status == MatchStatus::kOk ||
+                              from_guess.status == MatchStatus::kMbicpNotConverged) &&
+                             !far_from_guess(from_guess.pose);
+  if (jump_fitness >= options_.jump_min_relative_fitness * recent_fitness_ &&
+      (!guess_refined || jump_fitness > from_guess.fitness_ratio + options_.jump_margin)) {
+    return;  // a convincing leap: the prediction was wrong (wheel slip, a kidnapped robot)
+  }
+  update->jump_rejected = true;
+  if (!guess_refined) {
+    update->match.status = MatchStatus::kLowFitness;  // neither is convincing: fall back to the prediction
+    return;
+  }
+  MatchResult kept = from_guess;
+  kept.prealign_ms = update->match.prealign_ms;
+  kept.refine_ms += update->match.refine_ms;
+  kept.evaluations = update->match.evaluations;
+  kept.prealigned_pose = update->match.prealigned_pose;
+  update->match = kept;
 }
 
 PredictionSource OdometryTracker::predict(double stamp, Pose2D* predicted, std::string* warning) const {
@@ -173,10 +206,13 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
     std::vector<Pose2D>* population = population_out;
     update.match = matcher_.match(scan, laser_guess, population);
     update.matched = true;
+    guardAgainstJump(scan, laser_guess, update.prediction, &update);
     const bool match_ok = (update.match.status == MatchStatus::kOk ||
                            update.match.status == MatchStatus::kMbicpNotConverged) &&
                           update.match.fitness_ratio >= options_.min_fitness && update.match.pose.isFinite();
     if (match_ok) {
+      recent_fitness_ = recent_fitness_ > 0.0 ? 0.8 * recent_fitness_ + 0.2 * update.match.fitness_ratio
+                                              : update.match.fitness_ratio;
       const Pose2D base_estimate = laser_mount_ * update.match.pose * laser_mount_.inverse();
       const Eigen::Matrix3d base_cov = laserToBaseCovariance(laser_mount_, update.match.pose, update.match.covariance);
       new_pose = keyframe_pose_ * base_estimate;

@@ -175,26 +175,53 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
     }
   }
 
-  const auto start = std::chrono::steady_clock::now();
-  const MbicpResult refined = mbicp_.match(scan, result.prealigned_pose);
-  result.refine_ms = millisecondsSince(start);
-  result.pose = refined.pose;
-  result.iterations = refined.iterations;
-  result.associations = refined.associations;
-  result.rms_error = refined.rms_error;
-  result.mbicp_status = refined.status;
-  result.covariance = refined.covariance;
-  switch (refined.status) {
-    case MbicpStatus::kConverged: result.status = MatchStatus::kOk; break;
-    case MbicpStatus::kMaxIterations: result.status = MatchStatus::kMbicpNotConverged; break;
-    case MbicpStatus::kTooFewAssociations:
-    case MbicpStatus::kDegenerate: result.status = MatchStatus::kMbicpFailed; break;
-  }
+  refineInto(scan, &result);
   if (!usesGeneticStage(options_.algorithm) && table_.empty()) {
     // MbICP alone: report the fraction of points associated as the quality ratio.
-    result.fitness_ratio = static_cast<double>(refined.associations) / static_cast<double>(scan.size());
+    result.fitness_ratio = static_cast<double>(result.associations) / static_cast<double>(scan.size());
   }
   return result;
+}
+
+void ScanMatcher::refineInto(const Scan& scan, MatchResult* result) {
+  const auto start = std::chrono::steady_clock::now();
+  const MbicpResult refined = mbicp_.match(scan, result->prealigned_pose);
+  result->refine_ms = millisecondsSince(start);
+  result->pose = refined.pose;
+  result->iterations = refined.iterations;
+  result->associations = refined.associations;
+  result->rms_error = refined.rms_error;
+  result->mbicp_status = refined.status;
+  result->covariance = refined.covariance;
+  switch (refined.status) {
+    case MbicpStatus::kConverged: result->status = MatchStatus::kOk; break;
+    case MbicpStatus::kMaxIterations: result->status = MatchStatus::kMbicpNotConverged; break;
+    case MbicpStatus::kTooFewAssociations:
+    case MbicpStatus::kDegenerate: result->status = MatchStatus::kMbicpFailed; break;
+  }
+}
+
+MatchResult ScanMatcher::refine(const Scan& scan, const Pose2D& guess) {
+  MatchResult result;
+  result.pose = result.prealigned_pose = guess.isFinite() ? guess : Pose2D();
+  result.covariance = Eigen::Matrix3d::Identity() * 1e4;
+  if (!has_reference_) {
+    result.status = MatchStatus::kNoReference;
+    return result;
+  }
+  if (scan.size() < 3) {
+    result.status = MatchStatus::kTooFewPoints;
+    return result;
+  }
+  refineInto(scan, &result);
+  result.fitness_ratio = fitnessRatioAt(scan, result.pose);
+  return result;
+}
+
+double ScanMatcher::fitnessRatioAt(const Scan& scan, const Pose2D& pose) const {
+  if (table_.empty() || scan.empty()) return 0.0;
+  const double best = static_cast<double>(table_.maxCellValue()) * static_cast<double>(scan.size());
+  return table_.fitness(scan.points, pose) / best;
 }
 
 }  // namespace hglasm

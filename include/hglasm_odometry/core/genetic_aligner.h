@@ -66,7 +66,8 @@ class GeneticAligner {
   const GeneticOptions& options() const { return options_; }
 
  private:
-  void polish(const LookupTable& table, const FitnessPoints& points, PreAlignResult* result) const;
+  void polish(const LookupTable& table, const FitnessPoints& points, const Pose2D& guess,
+              PreAlignResult* result) const;
 
   GeneticOptions options_;
   std::mt19937_64 rng_;

@@ -30,6 +30,18 @@ struct TrackerOptions {
   /// constant-velocity prediction is used instead. A margin of 0.2 m / 0.2 rad is added for jitter.
   double max_odometry_speed = 5.0;       ///< m/s
   double max_odometry_turn_rate = 6.0;   ///< rad/s
+  /// A match farther than jump_distance + jump_fraction * |predicted motion| (or jump_angle +
+  /// jump_fraction * |predicted turn|) from an odometry or constant-velocity prediction is checked: MbICP
+  /// alone refines the prediction too, and the pre-aligned result is kept only if it fits the reference
+  /// better by jump_margin (fitness ratio). Stops the GA from leaping to a look-alike place (a corridor).
+  double jump_distance = 0.20;      ///< metres
+  double jump_angle = 0.15;         ///< radians
+  double jump_fraction = 0.25;
+  double jump_margin = 0.02;
+  /// A far match is kept only if its fitness ratio also reaches this fraction of the recent matches'
+  /// (a running mean): a leap needs strong evidence. If MbICP from the prediction strays as far, the
+  /// scene is not trustworthy (a crowd, a door swinging) and the prediction is integrated instead.
+  double jump_min_relative_fitness = 0.0;
   /// Odometry translation noise per metre and rotation noise per radian (for the guess covariance).
   double odometry_noise_xy = 0.05;
   double odometry_noise_theta = 0.05;
@@ -51,6 +63,7 @@ struct TrackerUpdate {
   PredictionSource prediction = PredictionSource::kNone;
   bool matched = false;       ///< a match was attempted (false for the first scan and after resets)
   bool fallback = false;      ///< match failed: the prediction was integrated instead
+  bool jump_rejected = false; ///< the pre-aligned match strayed from the prediction and lost to it
   bool new_keyframe = false;
   int keyframe_id = 0;
   bool reset = false;         ///< the tracker restarted (time jump, first scan after reset())
@@ -86,6 +99,8 @@ class OdometryTracker {
 
  private:
   PredictionSource predict(double stamp, Pose2D* predicted, std::string* warning) const;
+  void guardAgainstJump(const Scan& scan, const Pose2D& laser_guess, PredictionSource prediction,
+                        TrackerUpdate* update);
   void setKeyframe(double stamp, const Scan& scan, const Pose2D& pose,
                    const Eigen::Matrix3d& covariance);
 
@@ -99,6 +114,7 @@ class OdometryTracker {
   Pose2D pose_;
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
+  double recent_fitness_ = 0.0;  // running mean of accepted matches' fitness ratios (0: none yet)
   bool velocity_valid_ = false;
 
   std::deque<StampedPose> history_;  // recent poses, for the velocity

@@ -87,6 +87,12 @@ class ScanMatcher {
   MatchResult match(const Scan& scan, const Pose2D& guess,
                     std::vector<Pose2D>* population_out = nullptr);
 
+  /// MbICP alone from `guess` (no pre-alignment), e.g. to check a match that strayed far from a prediction.
+  MatchResult refine(const Scan& scan, const Pose2D& guess);
+
+  /// Fitness ratio of `scan` at `pose` on the fine lookup table (0 without a table).
+  double fitnessRatioAt(const Scan& scan, const Pose2D& pose) const;
+
   const MatcherOptions& options() const { return options_; }
   const LookupTable& table() const { return table_; }
   void reseed(std::uint64_t seed) { aligner_.reseed(seed); }
@@ -97,6 +103,8 @@ class ScanMatcher {
   LookupTable coarse_table_;
   GeneticAligner aligner_;
   Mbicp mbicp_;
+  void refineInto(const Scan& scan, MatchResult* result);
+
   bool has_reference_ = false;
   std::size_t reference_size_ = 0;
   double table_build_ms_ = 0.0;
