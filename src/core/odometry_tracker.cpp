@@ -1,5 +1,6 @@
 #include "hglasm_odometry/core/odometry_tracker.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -45,6 +46,20 @@ Eigen::Matrix3d odometryNoise(const TrackerOptions& options, const Pose2D& motio
   const double sigma_xy = options.odometry_noise_xy * motion.translationNorm() + 0.01;
   const double sigma_theta = options.odometry_noise_theta * std::abs(motion.theta) + 0.005;
   return Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_theta * sigma_theta).asDiagonal();
+}
+
+/// Information-weighted mean of a degenerate match and the prediction (both base motions since the
+/// keyframe, first order in the keyframe frame): the match decides the directions it constrains, the
+/// prediction the one it does not (along a featureless corridor). Covariances must be positive definite.
+Pose2D fuseWithPrediction(const Pose2D& match, const Eigen::Matrix3d& match_cov, const Pose2D& prediction,
+                          const Eigen::Matrix3d& prediction_cov, Eigen::Matrix3d* fused_cov) {
+  const Eigen::Matrix3d match_info = match_cov.inverse();
+  const Eigen::Matrix3d fused = (match_info + prediction_cov.inverse()).inverse();
+  const Eigen::Vector3d innovation(match.x - prediction.x, match.y - prediction.y,
+                                   normalizeAngle(match.theta - prediction.theta));
+  const Eigen::Vector3d correction = fused * match_info * innovation;
+  *fused_cov = 0.5 * (fused + fused.transpose());
+  return Pose2D(prediction.x + correction.x(), prediction.y + correction.y(), prediction.theta + correction.z());
 }
 
 }  // namespace
@@ -167,6 +182,9 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
            << " s; odometry reset to the origin";
       update.warning = text.str();
       reset();
+      // Back in time, the odometry history is of another timeline (a looped bag, a clock reset): mixed with
+      // the new samples at the same stamps it would turn every prediction into a jump.
+      if (dt < 0.0) odometry_.clear();
     }
   }
 
@@ -182,6 +200,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
     if (usable) {
       setKeyframe(stamp, scan, pose_, pose_covariance_);
       update.new_keyframe = true;
+      update.table_build_ms = matcher_.lastTableBuildMs();
     }
     update.keyframe_id = keyframe_id_;
     return update;
@@ -207,9 +226,14 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
     update.match = matcher_.match(scan, laser_guess, population);
     update.matched = true;
     guardAgainstJump(scan, laser_guess, update.prediction, &update);
+    const bool fits = update.match.fitness_ratio >= options_.min_fitness && update.match.pose.isFinite();
     const bool match_ok = (update.match.status == MatchStatus::kOk ||
-                           update.match.status == MatchStatus::kMbicpNotConverged) &&
-                          update.match.fitness_ratio >= options_.min_fitness && update.match.pose.isFinite();
+                           update.match.status == MatchStatus::kMbicpNotConverged) && fits;
+    // Degenerate geometry (a featureless corridor): the scan still fixes some directions; its covariance
+    // carries the maximum variance along the others, where the prediction decides.
+    const bool degenerate = update.match.status == MatchStatus::kMbicpFailed &&
+                            update.match.mbicp_status == MbicpStatus::kDegenerate && fits &&
+                            update.match.covariance.allFinite();
     if (match_ok) {
       recent_fitness_ = recent_fitness_ > 0.0 ? 0.8 * recent_fitness_ + 0.2 * update.match.fitness_ratio
                                               : update.match.fitness_ratio;
@@ -218,6 +242,19 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
       new_pose = keyframe_pose_ * base_estimate;
       new_covariance = composeCovariance(keyframe_pose_, keyframe_covariance_, base_estimate, base_cov);
       step_covariance = base_cov;
+    } else if (degenerate) {
+      const Pose2D base_estimate = laser_mount_ * update.match.pose * laser_mount_.inverse();
+      const Eigen::Matrix3d base_cov = laserToBaseCovariance(laser_mount_, update.match.pose, update.match.covariance);
+      Eigen::Matrix3d fused_cov;
+      const Pose2D fused =
+          fuseWithPrediction(base_estimate, base_cov, base_motion, odometryNoise(options_, base_motion), &fused_cov);
+      if (fused.isFinite() && fused_cov.allFinite()) {
+        new_pose = keyframe_pose_ * fused;
+        new_covariance = composeCovariance(keyframe_pose_, keyframe_covariance_, fused, fused_cov);
+        step_covariance = fused_cov;
+      } else {
+        update.fallback = true;
+      }
     } else {
       update.fallback = true;
     }
@@ -256,7 +293,8 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
   // A new reference when the robot has moved away from the keyframe, when the match was poor or failed
   // (the old reference no longer explains the scene), or when the scanner changed.
   const Pose2D since_keyframe = relativePose(keyframe_pose_, pose_);
-  const bool geometry_changed = has_keyframe_ && scan.beam_count != keyframe_beam_count_;
+  // Only a usable scan can become the new keyframe (an empty scan has no geometry): warn when it does.
+  const bool geometry_changed = has_keyframe_ && usable && scan.beam_count != keyframe_beam_count_;
   if (geometry_changed && update.warning.empty()) {
     update.warning = "scan beam count changed from " + std::to_string(keyframe_beam_count_) + " to " +
                      std::to_string(scan.beam_count) + "; new keyframe";
@@ -268,6 +306,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
   if (wants_keyframe && usable) {
     setKeyframe(stamp, scan, pose_, pose_covariance_);
     update.new_keyframe = true;
+    update.table_build_ms = matcher_.lastTableBuildMs();
   }
 
   update.published = true;

@@ -65,6 +65,7 @@ struct TrackerUpdate {
   bool fallback = false;      ///< match failed: the prediction was integrated instead
   bool jump_rejected = false; ///< the pre-aligned match strayed from the prediction and lost to it
   bool new_keyframe = false;
+  double table_build_ms = 0.0;  ///< lookup-table build of the new keyframe (wall ms; 0 if none)
   int keyframe_id = 0;
   bool reset = false;         ///< the tracker restarted (time jump, first scan after reset())
   std::string warning;        ///< non-empty: one line for the log

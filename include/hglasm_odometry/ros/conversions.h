@@ -1,0 +1,76 @@
+// Conversions between ROS 1 messages and the ROS-free core types. All functions are NaN/inf-safe:
+// they never throw and never put a non-finite number into an outgoing message.
+#pragma once
+
+#include <Eigen/Core>
+#include <boost/array.hpp>
+#include <string>
+
+#include <geometry_msgs/Pose.h>
+#include <geometry_msgs/Pose2D.h>
+#include <geometry_msgs/Quaternion.h>
+#include <geometry_msgs/Transform.h>
+#include <nav_msgs/Odometry.h>
+#include <sensor_msgs/LaserScan.h>
+
+#include "hglasm_odometry/core/pose2d.h"
+#include "hglasm_odometry/core/scan.h"
+
+namespace hglasm_odometry {
+
+/// Variance given to the unobserved dimensions (z, roll, pitch) of a planar estimate: large but
+/// finite, so consumers that invert the matrix (robot_localization) still can.
+constexpr double kUnobservedVariance = 1e6;
+
+/// The polar fields of a LaserScan. Ranges are copied unchanged (the core drops NaN/inf/out-of-limit
+/// ranges per REP-117). A non-finite or negative range_min becomes 0 and a non-finite or non-positive
+/// range_max becomes +inf, so one bad header field does not invalidate every beam.
+hglasm::RangeScan rangeScanFromMsg(const sensor_msgs::LaserScan& msg);
+
+/// The planar part of base -> laser.
+struct LaserMount {
+  /// Pose of the laser in the base frame, projected onto the base's xy plane (after mirroring).
+  hglasm::Pose2D base_to_laser;
+  /// The laser's z axis points down: seen from above its scan is a mirror image, so scans must be
+  /// converted with ScanConversionOptions::mirror = true before base_to_laser applies.
+  bool upside_down = false;
+  /// Angle between the laser's z axis and the base's z (or -z) axis, radians. Large tilts make the
+  /// planar projection inexact; callers warn about it.
+  double tilt = 0.0;
+};
+
+/// Projects a 3D base -> laser transform onto the plane. The 2x2 block R2 of the rotation is a rotation
+/// for an upright laser and a reflection for an upside-down one (R2 ~ Rot * diag(1, -1)): then the
+/// proper rotation R2 * diag(1, -1) is used together with mirrored scans. False (with *error) if the
+/// transform is not finite or its rotation is degenerate (laser plane vertical).
+bool laserMountFromTransform(const geometry_msgs::Transform& transform, LaserMount* mount,
+                             std::string* error);
+
+/// Yaw of a quaternion (normalised first); 0 for a zero-length or non-finite quaternion.
+double yawFromQuaternion(const geometry_msgs::Quaternion& q);
+/// Rotation about z; identity for a non-finite yaw.
+geometry_msgs::Quaternion quaternionFromYaw(double yaw);
+
+/// Planar part of a 3D pose. False (and *pose untouched) if the pose is not finite.
+bool pose2DFromPoseMsg(const geometry_msgs::Pose& msg, hglasm::Pose2D* pose);
+/// A pose in the z = 0 plane; non-finite components become 0.
+geometry_msgs::Pose poseMsgFromPose2D(const hglasm::Pose2D& pose);
+geometry_msgs::Transform transformMsgFromPose2D(const hglasm::Pose2D& pose);
+
+geometry_msgs::Pose2D pose2DMsgFromPose2D(const hglasm::Pose2D& pose);
+/// False (and *pose untouched) if the message is not finite.
+bool pose2DFromPose2DMsg(const geometry_msgs::Pose2D& msg, hglasm::Pose2D* pose);
+
+/// Pose of child_frame_id in header.frame_id. False if the pose is not finite.
+bool pose2DFromOdometryMsg(const nav_msgs::Odometry& msg, hglasm::Pose2D* pose);
+
+/// (x, y, theta) covariance -> row-major 6x6 (x, y, z, roll, pitch, yaw). Non-finite entries are
+/// replaced (diagonal: `unobserved_variance`, off-diagonal: 0) and the matrix is symmetrised; the
+/// z/roll/pitch diagonal gets `unobserved_variance`.
+boost::array<double, 36> covariance6x6FromPlanar(const Eigen::Matrix3d& covariance,
+                                                 double unobserved_variance = kUnobservedVariance);
+
+/// "/laser" -> "laser": tf2 rejects frame ids with a leading slash, old bags (ccny) still carry them.
+std::string stripLeadingSlash(const std::string& frame_id);
+
+}  // namespace hglasm_odometry

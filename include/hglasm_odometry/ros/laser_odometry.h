@@ -1,0 +1,143 @@
+// The live laser odometry: scans (+ wheel odometry) in, odometry, pose, tf, path, match statistics and
+// diagnostics out. Shared by the nodelet and the node; holds no global state, so several instances can
+// live in one process.
+//
+// Threads: the subscription callbacks only enqueue scans (a bounded queue that drops the oldest scan and
+// counts it) and feed wheel odometry to the tracker; one worker thread per instance converts, matches and
+// publishes. The tracker is guarded by a mutex shared by the worker, the odometry callback and ~reset.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
+#include <std_srvs/Empty.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "hglasm_odometry/core/odometry_tracker.h"
+#include "hglasm_odometry/ros/conversions.h"
+#include "hglasm_odometry/ros/parameters.h"
+
+namespace hglasm_odometry {
+
+class LaserOdometry {
+ public:
+  /// `nh` resolves the input topics (`scan`, `odom`), `private_nh` the outputs (~odom, ~pose, ~path,
+  /// ~match, ~ga_population) and ~reset. `options` must come from loadOptions() (already validated).
+  LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
+                const LaserOdometryOptions& options);
+  ~LaserOdometry();
+
+  LaserOdometry(const LaserOdometry&) = delete;
+  LaserOdometry& operator=(const LaserOdometry&) = delete;
+
+ private:
+  /// One processed scan, for the diagnostics window.
+  struct ScanRecord {
+    ros::WallTime time;
+    double cpu_ms = 0.0;
+    bool matched = false;
+    bool fallback = false;
+  };
+
+  void scanCallback(const sensor_msgs::LaserScanConstPtr& msg);
+  void odomCallback(const nav_msgs::OdometryConstPtr& msg);
+  bool resetCallback(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  void workerLoop();
+  /// Waits (bounded by options_.odometry_wait) until wheel odometry at or after `stamp` has arrived.
+  void waitForOdometry(const ros::Time& stamp);
+  /// Looks up base -> laser for `laser_frame` (cached); false while tf does not have it yet.
+  bool ensureLaserMount(const std::string& laser_frame);
+  void processScan(const sensor_msgs::LaserScan& msg);
+  void publish(const sensor_msgs::LaserScan& msg, const hglasm::TrackerUpdate& update,
+               const hglasm::Scan& scan, const hglasm::Pose2D& keyframe_before, double total_ms,
+               double table_build_ms);
+  void publishPopulation(const std_msgs::Header& header, const hglasm::TrackerUpdate& update,
+                         const std::vector<hglasm::Pose2D>& population);
+  /// Logs `text` as a warning unless the same `key` was logged less than `period` seconds ago.
+  void warnThrottled(const std::string& key, const std::string& text, double period);
+
+  const LaserOdometryOptions options_;
+  const std::string name_;  // private namespace, prefixes log lines
+  ros::NodeHandle nh_;
+  ros::NodeHandle private_nh_;
+
+  // The tracker and what is fed to it from several threads.
+  std::mutex tracker_mutex_;
+  hglasm::OdometryTracker tracker_;
+
+  // Bounded input queue (scan callback -> worker).
+  std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<sensor_msgs::LaserScanConstPtr> queue_;
+  std::uint32_t dropped_scans_ = 0;
+  bool stop_ = false;
+
+  // Newest wheel-odometry stamp (odometry callback -> worker).
+  std::mutex odom_stamp_mutex_;
+  std::condition_variable odom_stamp_cv_;
+  ros::Time newest_odom_stamp_;
+
+  // Worker-only state.
+  bool have_mount_ = false;
+  std::string mount_frame_;
+  LaserMount mount_;
+  bool have_last_geometry_ = false;
+  std::size_t last_beam_count_ = 0;
+  double last_angle_increment_ = 0.0;
+  hglasm::ScanError last_scan_error_ = hglasm::ScanError::kNone;
+  hglasm::Pose2D keyframe_pose_;  // base pose of the current keyframe (for Match.guess_pose)
+  std::deque<geometry_msgs::PoseStamped> path_;
+  bool warned_odom_child_frame_ = false;
+
+  // Diagnostics (guarded by stats_mutex_).
+  std::mutex stats_mutex_;
+  std::deque<ScanRecord> records_;
+  std::uint64_t scans_received_ = 0;
+  std::uint64_t scans_processed_ = 0;
+  std::uint64_t fallbacks_ = 0;
+  std::uint64_t resets_ = 0;
+  std::uint32_t last_reported_drops_ = 0;  // dropped_scans_ at the previous diagnostics report
+  ros::WallTime last_scan_time_;
+  std::atomic<bool> waiting_for_tf_{false};
+  std::string tf_wait_text_;
+
+  // Log throttling (per instance; rosconsole's THROTTLE macros share one timer between instances).
+  std::mutex log_mutex_;
+  std::map<std::string, ros::WallTime> last_warning_;
+
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+
+  ros::Publisher odom_pub_;
+  ros::Publisher pose_pub_;
+  ros::Publisher path_pub_;
+  ros::Publisher match_pub_;
+  ros::Publisher population_pub_;
+  ros::ServiceServer reset_service_;
+  diagnostic_updater::Updater diagnostics_;
+  ros::WallTimer diagnostics_timer_;
+  ros::Subscriber scan_sub_;
+  ros::Subscriber odom_sub_;
+
+  std::thread worker_;  // started last, joined first
+};
+
+}  // namespace hglasm_odometry

@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# Runs `evaluate` on the Freiburg relations benchmark logs (intel, fr079) for every preset and prints
+# one table: relations metric (all and <= 10 s) of the laser odometry next to the raw wheel odometry,
+# fallbacks and CPU per scan. Logs, trajectories and plots of each run go to the output directory.
+#
+# usage: scripts/evaluate_all.sh [-e EVALUATE] [-d DATASETS] [-o OUT_DIR] [-p "small medium large"]
+#                                [-l "intel fr079"] [-- extra evaluate arguments]
+#   -e  the evaluate binary (default: $EVALUATE, then `catkin_find hglasm_odometry evaluate`,
+#       then ../build*/devel/lib/hglasm_odometry/evaluate next to the package)
+#   -d  the datasets folder (default: <package>/../shared/datasets)
+#   -o  where run logs, trajectories and plots go (default: /tmp/hglasm_evaluate_all)
+#   -p  presets (default: the top-level keys of config/presets.yaml, else "small medium large")
+#   -l  logs (default: "intel fr079")
+# Example: scripts/evaluate_all.sh -e /work/build/devel/lib/hglasm_odometry/evaluate -- --config /tmp/my.yaml
+set -euo pipefail
+
+package_dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+evaluate="${EVALUATE:-}"
+datasets="$package_dir/../shared/datasets"
+out_dir="/tmp/hglasm_evaluate_all"
+presets=""
+logs="intel fr079"
+
+while getopts "e:d:o:p:l:h" option; do
+  case "$option" in
+    e) evaluate="$OPTARG" ;;
+    d) datasets="$OPTARG" ;;
+    o) out_dir="$OPTARG" ;;
+    p) presets="$OPTARG" ;;
+    l) logs="$OPTARG" ;;
+    h) sed -n '2,14p' "$0"; exit 0 ;;
+    *) sed -n '2,14p' "$0" >&2; exit 2 ;;
+  esac
+done
+shift $((OPTIND - 1))
+[[ "${1:-}" == "--" ]] && shift
+extra_args=("$@")
+
+if [[ -z "$evaluate" ]] && command -v catkin_find >/dev/null 2>&1; then
+  evaluate="$(catkin_find --first-only hglasm_odometry evaluate 2>/dev/null || true)"
+fi
+if [[ -z "$evaluate" ]]; then
+  evaluate="$(ls -t "$package_dir"/../build*/devel/lib/hglasm_odometry/evaluate 2>/dev/null | head -n1 || true)"
+fi
+if [[ -z "$evaluate" || ! -x "$evaluate" ]]; then
+  echo "evaluate_all: evaluate binary not found; build it and pass -e PATH (or set EVALUATE)" >&2
+  exit 2
+fi
+
+if [[ -z "$presets" ]]; then
+  presets_yaml="$package_dir/config/presets.yaml"
+  if [[ -f "$presets_yaml" ]]; then
+    presets="$(/usr/bin/python3 -c 'import sys, yaml
+d = yaml.safe_load(open(sys.argv[1])) or {}
+d = d.get("presets", d) if isinstance(d, dict) else {}
+print(" ".join(k for k, v in d.items() if isinstance(v, dict)))' "$presets_yaml")"
+  fi
+  [[ -n "$presets" ]] || presets="small medium large"
+fi
+
+mkdir -p "$out_dir"
+echo "evaluate: $evaluate"
+echo "runs:     $out_dir/<log>_<preset>.{log,txt,png}"
+[[ ${#extra_args[@]} -gt 0 ]] && echo "extra:    ${extra_args[*]}"
+echo
+
+header=$(printf "%-6s %-8s %6s %9s %21s | %-17s %-17s | %-17s %-17s" \
+  log preset scans fallback "CPU ms med/p99/max" "<=10s laser m/deg" "<=10s wheel" "all laser m/deg" "all wheel")
+echo "$header"
+printf '%*s\n' "${#header}" '' | tr ' ' '-'
+
+status=0
+for log in $logs; do
+  bag="$datasets/$log/$log.orig.bag"
+  relations="$datasets/$log/$log.relations"
+  if [[ ! -f "$bag" || ! -f "$relations" ]]; then
+    echo "$log: $bag or $relations missing, skipped" >&2
+    status=1
+    continue
+  fi
+  for preset in $presets; do
+    run="$out_dir/${log}_${preset}"
+    if ! "$evaluate" --bag "$bag" --relations "$relations" --preset "$preset" --quiet \
+         --out "$run.txt" --plot "$run.png" "${extra_args[@]}" >"$run.log" 2>&1; then
+      printf "%-6s %-8s evaluate failed, see %s\n" "$log" "$preset" "$run.log"
+      status=1
+      continue
+    fi
+    summary="$(grep '^SUMMARY' "$run.log" | tail -n1)"
+    field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$summary"; }
+    printf "%-6s %-8s %6s %8s%% %21s | %-17s %-17s | %-17s %-17s\n" "$log" "$preset" "$(field scans)" \
+      "$(field fallback_pct)" "$(field cpu_median_ms)/$(field cpu_p99_ms)/$(field cpu_max_ms)" \
+      "$(field short_t) / $(field short_r)" "$(field wheel_short_t) / $(field wheel_short_r)" \
+      "$(field all_t) / $(field all_r)" "$(field wheel_all_t) / $(field wheel_all_r)"
+  done
+done
+exit $status

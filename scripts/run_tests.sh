@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# THE test command: installs what is missing (apt, Debian package names), builds in Release, and runs
+# every test: core gtests, ROS-layer gtests, rostests on the bags in bags/, the launch-file check, the
+# core tests again under AddressSanitizer + UndefinedBehaviorSanitizer, and a bounded libFuzzer run.
+# Exits non-zero on any failure. Usage (as root on Debian 12): bash scripts/run_tests.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install_deps.sh
+source scripts/env.sh
+
+echo "== build (Release) into $HGLASM_BUILD"
+hglasm_build
+hglasm_build --target tests
+source "$HGLASM_BUILD/devel/setup.bash"
+
+echo "== gtest + rostest + launch check (ctest)"
+(cd "$HGLASM_BUILD" && ctest --output-on-failure)
+
+echo "== core tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+ASAN_BUILD="$HGLASM_ROOT/build-asan"
+if [ ! -f "$ASAN_BUILD/CMakeCache.txt" ]; then
+  cmake -S "$HGLASM_ROOT" -B "$ASAN_BUILD" -DHGLASM_CORE_ONLY=ON -DHGLASM_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
+fi
+cmake --build "$ASAN_BUILD" -j"$(nproc)" --target test_core
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  "$ASAN_BUILD/test_core" --gtest_brief=1
+
+if [ -f test/fuzz/fuzz_scan_matcher.cpp ]; then
+  echo "== libFuzzer: scan conversion + matching on arbitrary bytes (bounded)"
+  FUZZ_BUILD="$HGLASM_ROOT/build-fuzz"
+  if [ ! -f "$FUZZ_BUILD/CMakeCache.txt" ]; then
+    CC=clang CXX=clang++ cmake -S "$HGLASM_ROOT" -B "$FUZZ_BUILD" -DHGLASM_CORE_ONLY=ON -DHGLASM_FUZZ=ON \
+      -DCMAKE_BUILD_TYPE=RelWithDebInfo
+  fi
+  cmake --build "$FUZZ_BUILD" -j"$(nproc)" --target fuzz_scan_matcher
+  # Regression inputs first (every crash ever found is kept in test/fuzz/corpus), then new exploration.
+  mkdir -p "$FUZZ_BUILD/corpus"
+  "$FUZZ_BUILD/fuzz_scan_matcher" -max_total_time="${HGLASM_FUZZ_SECONDS:-60}" -print_final_stats=1 \
+    "$FUZZ_BUILD/corpus" test/fuzz/corpus
+fi
+echo "== all tests passed"

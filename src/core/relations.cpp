@@ -1,0 +1,110 @@
+// The Kümmerle et al. 2009 relations metric.
+#include "hglasm_odometry/core/relations.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+namespace hglasm {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+/// Index of the trajectory pose whose stamp is nearest to `stamp` if within `tolerance`, else -1.
+/// `trajectory` is sorted by stamp.
+long findStamp(const std::vector<StampedPose>& trajectory, double stamp, double tolerance) {
+  const auto after =
+      std::lower_bound(trajectory.begin(), trajectory.end(), stamp,
+                       [](const StampedPose& pose, double value) { return pose.stamp < value; });
+  long best = -1;
+  double best_gap = tolerance;
+  // The nearest stamp is either the first one at or after `stamp` or the one just before it.
+  for (auto it : {after, after == trajectory.begin() ? trajectory.end() : std::prev(after)}) {
+    if (it == trajectory.end()) continue;
+    const double gap = std::abs(it->stamp - stamp);
+    if (gap <= best_gap) {
+      best_gap = gap;
+      best = static_cast<long>(it - trajectory.begin());
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+bool readRelations(const std::string& path, std::vector<Relation>* relations, std::string* error) {
+  std::ifstream file(path);
+  if (!file) {
+    if (error) *error = "cannot open relations file '" + path + "'";
+    return false;
+  }
+  relations->clear();
+  std::string line;
+  int line_number = 0;
+  while (std::getline(file, line)) {
+    ++line_number;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;  // blank line or comment
+    std::istringstream fields(line);
+    double t1, t2, x, y, z, roll, pitch, yaw;
+    if (!(fields >> t1 >> t2 >> x >> y >> z >> roll >> pitch >> yaw) || !std::isfinite(t1) ||
+        !std::isfinite(t2) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(yaw)) {
+      if (error) {
+        *error = path + ":" + std::to_string(line_number) + ": expected 't1 t2 x y z roll pitch yaw', got '" +
+                 line + "'";
+      }
+      return false;
+    }
+    Relation relation;
+    relation.t1 = t1;
+    relation.t2 = t2;
+    relation.motion = Pose2D(x, y, yaw);
+    relations->push_back(relation);
+  }
+  return true;
+}
+
+RelationStats evaluateRelations(const std::vector<Relation>& relations,
+                                const std::vector<StampedPose>& trajectory, double max_span,
+                                double stamp_tolerance) {
+  RelationStats stats;
+  std::vector<double> trans_errors, rot_errors_deg;
+  for (const Relation& relation : relations) {
+    if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
+    const long i1 = findStamp(trajectory, relation.t1, stamp_tolerance);
+    const long i2 = findStamp(trajectory, relation.t2, stamp_tolerance);
+    if (i1 < 0 || i2 < 0) {
+      ++stats.missing;
+      continue;
+    }
+    const Pose2D estimated = relativePose(trajectory[i1].pose, trajectory[i2].pose);
+    // Kümmerle's estimated ⊖ reference: the residual motion left once the reference is undone.
+    const Pose2D residual = relativePose(relation.motion, estimated);
+    trans_errors.push_back(residual.translationNorm());
+    rot_errors_deg.push_back(std::abs(normalizeAngle(residual.theta)) * kRadToDeg);
+  }
+  stats.count = static_cast<int>(trans_errors.size());
+  if (stats.count == 0) return stats;
+  // Two passes (mean, then spread) so tiny spreads are not lost to cancellation.
+  const auto moments = [](const std::vector<double>& values, double* mean, double* std_dev, double* sq_mean) {
+    double sum = 0.0, sq_sum = 0.0;
+    for (double value : values) {
+      sum += value;
+      sq_sum += value * value;
+    }
+    const double n = static_cast<double>(values.size());
+    *mean = sum / n;
+    *sq_mean = sq_sum / n;
+    double spread = 0.0;
+    for (double value : values) spread += (value - *mean) * (value - *mean);
+    *std_dev = std::sqrt(spread / n);  // population standard deviation
+  };
+  moments(trans_errors, &stats.trans_mean, &stats.trans_std, &stats.trans_sq_mean);
+  moments(rot_errors_deg, &stats.rot_mean_deg, &stats.rot_std_deg, &stats.rot_sq_mean_deg);
+  return stats;
+}
+
+}  // namespace hglasm

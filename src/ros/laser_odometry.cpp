@@ -1,0 +1,564 @@
+#include "hglasm_odometry/ros/laser_odometry.h"
+
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Path.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "hglasm_odometry/Match.h"
+
+namespace hglasm_odometry {
+namespace {
+
+/// CPU time of the calling thread, milliseconds.
+double threadCpuMs() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return now.tv_sec * 1e3 + now.tv_nsec * 1e-6;
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Floats for the Match message: never NaN.
+float finiteFloat(double value) { return std::isfinite(value) ? static_cast<float>(value) : 0.0f; }
+
+std::uint8_t toMsg(hglasm::MatchStatus status) {
+  switch (status) {
+    case hglasm::MatchStatus::kOk:
+      return Match::STATUS_OK;
+    case hglasm::MatchStatus::kNoReference:
+      return Match::STATUS_NO_REFERENCE;
+    case hglasm::MatchStatus::kTooFewPoints:
+      return Match::STATUS_TOO_FEW_POINTS;
+    case hglasm::MatchStatus::kLowFitness:
+      return Match::STATUS_LOW_FITNESS;
+    case hglasm::MatchStatus::kMbicpFailed:
+      return Match::STATUS_MBICP_FAILED;
+    case hglasm::MatchStatus::kMbicpNotConverged:
+      return Match::STATUS_MBICP_NOT_CONVERGED;
+  }
+  return Match::STATUS_NO_REFERENCE;
+}
+
+std::uint8_t toMsg(hglasm::MbicpStatus status) {
+  switch (status) {
+    case hglasm::MbicpStatus::kConverged:
+      return Match::MBICP_CONVERGED;
+    case hglasm::MbicpStatus::kMaxIterations:
+      return Match::MBICP_MAX_ITERATIONS;
+    case hglasm::MbicpStatus::kTooFewAssociations:
+      return Match::MBICP_TOO_FEW_ASSOCIATIONS;
+    case hglasm::MbicpStatus::kDegenerate:
+      return Match::MBICP_DEGENERATE;
+  }
+  return Match::MBICP_DEGENERATE;
+}
+
+std::uint8_t toMsg(hglasm::PredictionSource source) {
+  switch (source) {
+    case hglasm::PredictionSource::kOdometry:
+      return Match::PREDICTION_ODOMETRY;
+    case hglasm::PredictionSource::kConstantVelocity:
+      return Match::PREDICTION_CONSTANT_VELOCITY;
+    case hglasm::PredictionSource::kNone:
+      return Match::PREDICTION_NONE;
+  }
+  return Match::PREDICTION_NONE;
+}
+
+/// Subscriber queues only need to absorb bursts until the callback moves the message into the bounded
+/// queue (callbacks are cheap); they are not where scans are dropped.
+constexpr int kScanSubscriberQueue = 50;
+constexpr int kOdomSubscriberQueue = 200;
+constexpr double kTfRetrySeconds = 0.05;  // wall time between tf lookups while waiting for base -> laser
+
+}  // namespace
+
+LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
+                             const LaserOdometryOptions& options)
+    : options_(options),
+      name_(private_nh.getNamespace()),
+      nh_(nh),
+      private_nh_(private_nh),
+      tracker_(options.tracker),
+      tf_listener_(tf_buffer_),
+      diagnostics_(nh, private_nh, private_nh.getNamespace()) {
+  // Outputs first, inputs last: nothing arrives before there is somewhere to publish it.
+  odom_pub_ = private_nh_.advertise<nav_msgs::Odometry>("odom", 50);
+  pose_pub_ = private_nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose", 50);
+  if (options_.path_length > 0) path_pub_ = private_nh_.advertise<nav_msgs::Path>("path", 2);
+  match_pub_ = private_nh_.advertise<Match>("match", 50);
+  if (options_.publish_population) {
+    population_pub_ = private_nh_.advertise<visualization_msgs::MarkerArray>("ga_population", 2);
+  }
+  reset_service_ = private_nh_.advertiseService("reset", &LaserOdometry::resetCallback, this);
+
+  diagnostics_.setHardwareID("none");
+  diagnostics_.add("laser odometry", this, &LaserOdometry::diagnose);
+  diagnostics_timer_ =
+      private_nh_.createWallTimer(ros::WallDuration(options_.diagnostics.period),
+                                  [this](const ros::WallTimerEvent&) { diagnostics_.force_update(); });
+
+  worker_ = std::thread(&LaserOdometry::workerLoop, this);
+
+  scan_sub_ = nh_.subscribe("scan", kScanSubscriberQueue, &LaserOdometry::scanCallback, this,
+                            ros::TransportHints().tcpNoDelay());
+  if (options_.use_odom) {
+    odom_sub_ = nh_.subscribe("odom", kOdomSubscriberQueue, &LaserOdometry::odomCallback, this,
+                              ros::TransportHints().tcpNoDelay());
+  }
+  ROS_INFO_STREAM(
+      "[" << name_ << "] laser odometry on " << scan_sub_.getTopic()
+          << (options_.use_odom ? " + " + odom_sub_.getTopic() : std::string(" (no wheel odometry)")) << ": "
+          << summarize(options_));
+}
+
+LaserOdometry::~LaserOdometry() {
+  scan_sub_.shutdown();
+  odom_sub_.shutdown();
+  reset_service_.shutdown();
+  diagnostics_timer_.stop();
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    stop_ = true;
+  }
+  queue_cv_.notify_all();
+  odom_stamp_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void LaserOdometry::scanCallback(const sensor_msgs::LaserScanConstPtr& msg) {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    if (queue_.size() >= static_cast<std::size_t>(options_.queue_size)) {
+      queue_.pop_front();  // the oldest scan is the least useful one to a live estimate
+      ++dropped_scans_;
+    }
+    queue_.push_back(msg);
+  }
+  queue_cv_.notify_one();
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++scans_received_;
+  last_scan_time_ = ros::WallTime::now();
+}
+
+void LaserOdometry::odomCallback(const nav_msgs::OdometryConstPtr& msg) {
+  hglasm::Pose2D pose;
+  if (!pose2DFromOdometryMsg(*msg, &pose)) {
+    warnThrottled("odom_nan", "wheel odometry message with a non-finite pose ignored", 10.0);
+    return;
+  }
+  const std::string child = stripLeadingSlash(msg->child_frame_id);
+  if (!child.empty() && child != options_.base_frame && !warned_odom_child_frame_) {
+    warned_odom_child_frame_ = true;  // once: the configuration will not change by itself
+    ROS_WARN_STREAM("[" << name_ << "] wheel odometry on " << odom_sub_.getTopic() << " is of frame \""
+                        << child << "\", not of base_frame \"" << options_.base_frame
+                        << "\"; it is used as the motion of base_frame anyway");
+  }
+  {
+    std::lock_guard<std::mutex> lock(tracker_mutex_);
+    tracker_.addOdometry(msg->header.stamp.toSec(), pose);
+  }
+  {
+    std::lock_guard<std::mutex> lock(odom_stamp_mutex_);
+    if (msg->header.stamp > newest_odom_stamp_) newest_odom_stamp_ = msg->header.stamp;
+  }
+  odom_stamp_cv_.notify_all();
+}
+
+void LaserOdometry::waitForOdometry(const ros::Time& stamp) {
+  // Odometry that stopped (or never came) is not waited for: the tracker falls back to its prediction.
+  constexpr double kStoppedAfter = 1.0;  // seconds of scan time without odometry
+  std::unique_lock<std::mutex> lock(odom_stamp_mutex_);
+  if (newest_odom_stamp_.isZero() || (stamp - newest_odom_stamp_).toSec() > kStoppedAfter) return;
+  odom_stamp_cv_.wait_for(lock, std::chrono::duration<double>(options_.odometry_wait), [this, &stamp] {
+    std::lock_guard<std::mutex> queue_lock(queue_mutex_);
+    return stop_ || newest_odom_stamp_ >= stamp;
+  });
+}
+
+bool LaserOdometry::resetCallback(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  {
+    std::lock_guard<std::mutex> lock(tracker_mutex_);
+    tracker_.reset();
+  }
+  ROS_INFO_STREAM("[" << name_ << "] reset requested: restarting from the origin at the next scan");
+  return true;
+}
+
+void LaserOdometry::warnThrottled(const std::string& key, const std::string& text, double period) {
+  const ros::WallTime now = ros::WallTime::now();
+  {
+    std::lock_guard<std::mutex> lock(log_mutex_);
+    auto it = last_warning_.find(key);
+    if (it != last_warning_.end() && (now - it->second).toSec() < period) return;
+    last_warning_[key] = now;
+  }
+  ROS_WARN_STREAM("[" << name_ << "] " << text);
+}
+
+bool LaserOdometry::ensureLaserMount(const std::string& laser_frame) {
+  if (have_mount_ && laser_frame == mount_frame_) return true;
+  LaserMount mount;
+  if (laser_frame.empty() || laser_frame == options_.base_frame) {
+    // The scans are in the base frame (or say nothing): no tf needed.
+    if (laser_frame.empty()) {
+      ROS_WARN_STREAM("[" << name_ << "] scans carry no frame_id; assuming the laser is at the origin of "
+                          << options_.base_frame);
+    }
+  } else {
+    geometry_msgs::TransformStamped transform;
+    try {
+      transform = tf_buffer_.lookupTransform(options_.base_frame, laser_frame, ros::Time(0));
+    } catch (const tf2::TransformException& ex) {
+      std::ostringstream text;
+      text << "waiting for the transform " << options_.base_frame << " -> " << laser_frame
+           << " (base_frame -> scan frame_id) on tf/tf_static; scans are held until it appears (" << ex.what()
+           << ")";
+      {
+        std::lock_guard<std::mutex> lock(stats_mutex_);
+        tf_wait_text_ = "waiting for tf " + options_.base_frame + " -> " + laser_frame;
+      }
+      waiting_for_tf_ = true;
+      warnThrottled("tf_wait", text.str(), options_.tf_warn_period);
+      return false;
+    }
+    std::string error;
+    if (!laserMountFromTransform(transform.transform, &mount, &error)) {
+      warnThrottled("tf_bad",
+                    "unusable transform " + options_.base_frame + " -> " + laser_frame + ": " + error,
+                    options_.tf_warn_period);
+      waiting_for_tf_ = true;
+      return false;
+    }
+  }
+  waiting_for_tf_ = false;
+  have_mount_ = true;
+  mount_frame_ = laser_frame;
+  mount_ = mount;
+  {
+    std::lock_guard<std::mutex> lock(tracker_mutex_);
+    tracker_.setLaserMount(mount.base_to_laser);
+  }
+  ROS_INFO_STREAM("[" << name_ << "] scan frame \"" << laser_frame << "\" at x " << mount.base_to_laser.x
+                      << " m, y " << mount.base_to_laser.y << " m, yaw " << mount.base_to_laser.theta
+                      << " rad in \"" << options_.base_frame << "\""
+                      << (mount.upside_down ? ", upside down (scans mirrored)" : ""));
+  if (mount.tilt > 0.05) {
+    ROS_WARN_STREAM("[" << name_ << "] the laser's scan plane is tilted by " << mount.tilt
+                        << " rad from the base plane; its planar projection is approximate");
+  }
+  return true;
+}
+
+void LaserOdometry::workerLoop() {
+  while (true) {
+    sensor_msgs::LaserScanConstPtr msg;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_cv_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      if (stop_) return;
+      msg = queue_.front();
+      queue_.pop_front();
+    }
+    if (!ensureLaserMount(stripLeadingSlash(msg->header.frame_id))) {
+      // Hold the scan (at the front, unless the queue filled up meanwhile: then it is the oldest and
+      // is dropped) and retry shortly.
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      if (queue_.size() < static_cast<std::size_t>(options_.queue_size)) {
+        queue_.push_front(msg);
+      } else {
+        ++dropped_scans_;
+      }
+      queue_cv_.wait_for(lock, std::chrono::duration<double>(kTfRetrySeconds), [this] { return stop_; });
+      if (stop_) return;
+      continue;
+    }
+    processScan(*msg);
+  }
+}
+
+void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
+  if (options_.use_odom && options_.odometry_wait > 0.0) waitForOdometry(msg.header.stamp);
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = threadCpuMs();
+
+  hglasm::ScanConversionOptions conversion = options_.tracker.conversion;
+  conversion.mirror = mount_.upside_down;
+  hglasm::ScanError scan_error = hglasm::ScanError::kNone;
+  const hglasm::Scan scan = hglasm::scanFromRanges(rangeScanFromMsg(msg), conversion, &scan_error);
+  if (scan_error != last_scan_error_) {
+    // One message per change of state, not per scan.
+    if (scan_error != hglasm::ScanError::kNone) {
+      ROS_WARN_STREAM("[" << name_ << "] unusable scan (" << hglasm::toString(scan_error)
+                          << "); integrating the prediction until scans are valid again");
+    } else {
+      ROS_INFO_STREAM("[" << name_ << "] scans are valid again");
+    }
+    last_scan_error_ = scan_error;
+  }
+
+  std::vector<hglasm::Pose2D> population;
+  const bool want_population = options_.publish_population && population_pub_.getNumSubscribers() > 0;
+  hglasm::TrackerUpdate update;
+  const hglasm::Pose2D keyframe_before = keyframe_pose_;
+  {
+    std::lock_guard<std::mutex> lock(tracker_mutex_);
+    // A changed angular geometry with the same beam count is not visible to the tracker (it compares beam
+    // counts): make this scan a keyframe so it is never matched against a reference of other geometry.
+    if (scan_error == hglasm::ScanError::kNone) {
+      const bool increment_changed = have_last_geometry_ && msg.ranges.size() == last_beam_count_ &&
+                                     std::abs(msg.angle_increment - last_angle_increment_) >
+                                         1e-6 * std::abs(last_angle_increment_) + 1e-9;
+      if (increment_changed) {
+        ROS_WARN_STREAM("[" << name_ << "] scan angle_increment changed from " << last_angle_increment_
+                            << " to " << msg.angle_increment << "; new keyframe");
+        tracker_.requestKeyframe();
+      }
+      have_last_geometry_ = true;
+      last_beam_count_ = msg.ranges.size();
+      last_angle_increment_ = msg.angle_increment;
+    }
+    update = tracker_.processScan(msg.header.stamp.toSec(), scan, want_population ? &population : nullptr);
+  }
+  if (!update.warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << update.warning);
+  if (update.reset) path_.clear();
+  if (update.new_keyframe) keyframe_pose_ = update.pose;
+
+  publish(msg, update, scan, keyframe_before, msSince(start), update.table_build_ms);
+  if (want_population && update.matched) publishPopulation(msg.header, update, population);
+
+  ScanRecord record;
+  record.time = ros::WallTime::now();
+  record.cpu_ms = threadCpuMs() - cpu_start;
+  record.matched = update.matched;
+  record.fallback = update.fallback;
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++scans_processed_;
+  if (update.fallback) ++fallbacks_;
+  if (update.reset) ++resets_;
+  records_.push_back(record);
+  while (!records_.empty() && (record.time - records_.front().time).toSec() > options_.diagnostics.window) {
+    records_.pop_front();
+  }
+}
+
+void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::TrackerUpdate& update,
+                            const hglasm::Scan& scan, const hglasm::Pose2D& keyframe_before, double total_ms,
+                            double table_build_ms) {
+  const ros::Time stamp = msg.header.stamp;
+  if (update.published) {
+    const boost::array<double, 36> pose_covariance = covariance6x6FromPlanar(update.pose_covariance);
+    const geometry_msgs::Pose pose = poseMsgFromPose2D(update.pose);
+
+    nav_msgs::Odometry odom;
+    odom.header.stamp = stamp;
+    odom.header.frame_id = options_.odom_frame;
+    odom.child_frame_id = options_.base_frame;
+    odom.pose.pose = pose;
+    odom.pose.covariance = pose_covariance;
+    const bool velocity_finite = update.velocity.allFinite();
+    odom.twist.twist.linear.x = velocity_finite ? update.velocity.x() : 0.0;
+    odom.twist.twist.linear.y = velocity_finite ? update.velocity.y() : 0.0;
+    odom.twist.twist.angular.z = velocity_finite ? update.velocity.z() : 0.0;
+    odom.twist.covariance = covariance6x6FromPlanar(update.velocity_covariance);
+    odom_pub_.publish(odom);
+
+    geometry_msgs::PoseWithCovarianceStamped pose_msg;
+    pose_msg.header = odom.header;
+    pose_msg.pose.pose = pose;
+    pose_msg.pose.covariance = pose_covariance;
+    pose_pub_.publish(pose_msg);
+
+    if (options_.publish_tf) {
+      geometry_msgs::TransformStamped transform;
+      transform.header = odom.header;
+      transform.child_frame_id = options_.base_frame;
+      transform.transform = transformMsgFromPose2D(update.pose);
+      tf_broadcaster_.sendTransform(transform);
+    }
+
+    if (options_.path_length > 0) {
+      geometry_msgs::PoseStamped path_pose;
+      path_pose.header = odom.header;
+      path_pose.pose = pose;
+      path_.push_back(path_pose);
+      while (path_.size() > static_cast<std::size_t>(options_.path_length)) path_.pop_front();
+      if (path_pub_.getNumSubscribers() > 0) {
+        nav_msgs::Path path;
+        path.header = odom.header;
+        path.poses.assign(path_.begin(), path_.end());
+        path_pub_.publish(path);
+      }
+    }
+  }
+
+  Match match;
+  match.header.stamp = stamp;
+  match.header.frame_id = stripLeadingSlash(msg.header.frame_id);
+  match.prediction_source = toMsg(update.prediction);
+  match.status = toMsg(update.match.status);
+  match.status_text = hglasm::toString(update.match.status);
+  match.jump_rejected = update.jump_rejected;
+  match.mbicp_status = toMsg(update.match.mbicp_status);
+  match.matched = update.matched;
+  match.fallback = update.fallback;
+  match.new_keyframe = update.new_keyframe;
+  match.reset = update.reset;
+  match.keyframe_id = static_cast<std::uint32_t>(std::max(0, update.keyframe_id));
+  if (update.matched) {
+    // The guess as the matcher saw it: the new laser pose in the keyframe's laser frame.
+    const hglasm::Pose2D& mount = mount_.base_to_laser;
+    const hglasm::Pose2D laser_guess = mount.inverse() * relativePose(keyframe_before, update.guess) * mount;
+    match.guess_pose = pose2DMsgFromPose2D(laser_guess);
+    match.prealigned_pose = pose2DMsgFromPose2D(update.match.prealigned_pose);
+    match.final_pose = pose2DMsgFromPose2D(update.match.pose);
+  }
+  match.fitness = update.match.fitness;
+  match.fitness_ratio = finiteFloat(update.match.fitness_ratio);
+  match.evaluations = static_cast<std::uint32_t>(std::max(0, update.match.evaluations));
+  match.iterations = static_cast<std::uint32_t>(std::max(0, update.match.iterations));
+  match.associations = static_cast<std::uint32_t>(std::max(0, update.match.associations));
+  match.rms_error = finiteFloat(update.match.rms_error);
+  match.valid_points = static_cast<std::uint32_t>(scan.size());
+  match.invalid_points = static_cast<std::uint32_t>(std::max(0, scan.invalid_count));
+  match.table_build_ms = finiteFloat(table_build_ms);
+  match.prealign_ms = finiteFloat(update.match.prealign_ms);
+  match.refine_ms = finiteFloat(update.match.refine_ms);
+  match.total_ms = finiteFloat(total_ms);
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    match.dropped_scans = dropped_scans_;
+  }
+  match_pub_.publish(match);
+}
+
+void LaserOdometry::publishPopulation(const std_msgs::Header& header, const hglasm::TrackerUpdate& update,
+                                      const std::vector<hglasm::Pose2D>& population) {
+  visualization_msgs::MarkerArray markers;
+  // Each individual as a short heading segment from its position (one LINE_LIST: cheap to send and draw).
+  visualization_msgs::Marker individuals;
+  individuals.header.stamp = header.stamp;
+  individuals.header.frame_id = options_.odom_frame;
+  individuals.ns = "ga_population";
+  individuals.id = 0;
+  individuals.type = visualization_msgs::Marker::LINE_LIST;
+  individuals.action = visualization_msgs::Marker::ADD;
+  individuals.pose.orientation.w = 1.0;
+  individuals.scale.x = 0.01;
+  individuals.color.r = 1.0f;
+  individuals.color.g = 0.6f;
+  individuals.color.a = 0.8f;
+  constexpr double kHeadingLength = 0.08;
+  for (const hglasm::Pose2D& pose : population) {
+    if (!pose.isFinite()) continue;
+    geometry_msgs::Point from, to;
+    from.x = pose.x;
+    from.y = pose.y;
+    to.x = pose.x + kHeadingLength * std::cos(pose.theta);
+    to.y = pose.y + kHeadingLength * std::sin(pose.theta);
+    individuals.points.push_back(from);
+    individuals.points.push_back(to);
+  }
+  markers.markers.push_back(individuals);
+
+  // The final estimate (green) and the prediction the search box was centred on (blue).
+  auto arrow = [&](int id, const hglasm::Pose2D& pose, float r, float g, float b) {
+    visualization_msgs::Marker marker;
+    marker.header = individuals.header;
+    marker.ns = "ga_estimate";
+    marker.id = id;
+    marker.type = visualization_msgs::Marker::ARROW;
+    marker.action = visualization_msgs::Marker::ADD;
+    marker.pose = poseMsgFromPose2D(pose);
+    marker.scale.x = 0.3;
+    marker.scale.y = 0.04;
+    marker.scale.z = 0.04;
+    marker.color.r = r;
+    marker.color.g = g;
+    marker.color.b = b;
+    marker.color.a = 1.0f;
+    return marker;
+  };
+  markers.markers.push_back(arrow(1, update.pose, 0.1f, 0.9f, 0.1f));
+  markers.markers.push_back(arrow(2, update.guess, 0.2f, 0.4f, 1.0f));
+  population_pub_.publish(markers);
+}
+
+void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const ros::WallTime now = ros::WallTime::now();
+  std::size_t queued = 0;
+  std::uint32_t dropped_total = 0;
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    queued = queue_.size();
+    dropped_total = dropped_scans_;
+  }
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  while (!records_.empty() && (now - records_.front().time).toSec() > options_.diagnostics.window) {
+    records_.pop_front();
+  }
+  const std::size_t count = records_.size();
+  double cpu_sum = 0.0, cpu_max = 0.0;
+  // Every scan that should have given a laser estimate counts: a failed match, but also an empty or
+  // all-invalid scan (a blinded or disconnected laser), whose motion came from the prediction alone.
+  std::size_t matched = 0, failed = 0;
+  for (const ScanRecord& record : records_) {
+    cpu_sum += record.cpu_ms;
+    cpu_max = std::max(cpu_max, record.cpu_ms);
+    if (record.matched || record.fallback) ++matched;
+    if (record.fallback) ++failed;
+  }
+  // Processing rate over the records in the window (wall clock: what the robot's computer sustains).
+  const double span = count >= 2 ? (records_.back().time - records_.front().time).toSec() : 0.0;
+  const double rate = span > 0.0 ? (count - 1) / span : 0.0;
+  const double cpu_mean = count > 0 ? cpu_sum / count : 0.0;
+  const double failure_ratio = matched > 0 ? static_cast<double>(failed) / matched : 0.0;
+
+  status.add("scan rate (Hz)", rate);
+  status.add("CPU per scan, mean (ms)", cpu_mean);
+  status.add("CPU per scan, max (ms)", cpu_max);
+  status.add("failure ratio", failure_ratio);
+  status.add("scans received", scans_received_);
+  status.add("scans processed", scans_processed_);
+  status.add("fallbacks", fallbacks_);
+  status.add("resets", resets_);
+  status.add("dropped scans", dropped_total);
+  status.add("queued scans", queued);
+  status.add("preset", options_.preset);
+
+  const bool scans_arriving =
+      !last_scan_time_.isZero() && (now - last_scan_time_).toSec() <= options_.diagnostics.window;
+  if (waiting_for_tf_) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, tf_wait_text_);
+  } else if (!scans_arriving) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   last_scan_time_.isZero() ? "no scans received yet" : "no scans received recently");
+  } else if (matched > 0 && failure_ratio >= options_.diagnostics.error_failure_ratio) {
+    status.summaryf(diagnostic_msgs::DiagnosticStatus::ERROR, "%.0f%% of scans failed to match",
+                    100.0 * failure_ratio);
+  } else if (matched > 0 && failure_ratio >= options_.diagnostics.warn_failure_ratio) {
+    status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%.0f%% of scans failed to match",
+                    100.0 * failure_ratio);
+  } else if (dropped_total > last_reported_drops_) {
+    status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                    "dropping scans: %u dropped so far (processing is slower than the input)", dropped_total);
+  } else if (options_.diagnostics.min_rate > 0.0 && rate < options_.diagnostics.min_rate) {
+    status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "scan rate %.2f Hz below %.2f Hz", rate,
+                    options_.diagnostics.min_rate);
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
+  }
+  last_reported_drops_ = dropped_total;
+}
+
+}  // namespace hglasm_odometry

@@ -1,0 +1,459 @@
+#include "hglasm_odometry/ros/parameters.h"
+
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "hglasm_odometry/core/scan_matcher.h"
+#include "hglasm_odometry/ros/conversions.h"
+
+namespace hglasm_odometry {
+namespace {
+
+using XmlRpc::XmlRpcValue;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// "5", "-0.3", "string \"abc\"", "a list": how a value appears in an error message.
+std::string describe(const XmlRpcValue& value) {
+  XmlRpcValue copy = value;  // the typed conversions of XmlRpcValue are not const
+  std::ostringstream out;
+  switch (copy.getType()) {
+    case XmlRpcValue::TypeBoolean:
+      out << (static_cast<bool>(copy) ? "true" : "false");
+      break;
+    case XmlRpcValue::TypeInt:
+      out << static_cast<int>(copy);
+      break;
+    case XmlRpcValue::TypeDouble:
+      out << static_cast<double>(copy);
+      break;
+    case XmlRpcValue::TypeString:
+      out << "string \"" << static_cast<std::string>(copy) << "\"";
+      break;
+    case XmlRpcValue::TypeArray:
+      out << "a list";
+      break;
+    case XmlRpcValue::TypeStruct:
+      out << "a dictionary";
+      break;
+    default:
+      out << "a value of an unsupported type";
+      break;
+  }
+  return out.str();
+}
+
+std::string formatNumber(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+/// Typed, validating reads from one parameter subtree. The first error wins; later reads are no-ops.
+/// Every path read is remembered, so the keys never read can be reported as unknown.
+class ParamTree {
+ public:
+  ParamTree(const XmlRpcValue& root, std::string display_prefix, std::string* error)
+      : root_(root), prefix_(std::move(display_prefix)), error_(error) {}
+
+  bool failed() const { return failed_; }
+
+  /// Finds `path` ("genetic/population"); false if absent. Marks the path as known either way.
+  bool find(const std::string& path, XmlRpcValue* value) {
+    known_.insert(path);
+    if (failed_) return false;
+    const XmlRpcValue* node = &root_;
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t slash = path.find('/', start);
+      const std::string key =
+          path.substr(start, slash == std::string::npos ? std::string::npos : slash - start);
+      if (node->getType() != XmlRpcValue::TypeStruct || !node->hasMember(key)) return false;
+      node = &(*node)[key];
+      if (slash == std::string::npos) break;
+      start = slash + 1;
+    }
+    *value = *node;
+    return true;
+  }
+
+  void fail(const std::string& path, const std::string& requirement, const std::string& got) {
+    if (failed_) return;
+    failed_ = true;
+    if (error_) *error_ = "parameter " + prefix_ + path + " must be " + requirement + ", got " + got;
+  }
+
+  /// A number (int or double) within [lo, hi]; `positive` additionally excludes 0. Infinity only if
+  /// `allow_inf`.
+  void number(const std::string& path, double* out, double lo, double hi, bool positive = false,
+              bool allow_inf = false) {
+    XmlRpcValue value;
+    if (!find(path, &value)) return;
+    std::string requirement;
+    if (positive && hi == kInf) {
+      requirement = "a positive number";
+    } else if (lo == 0.0 && hi == kInf) {
+      requirement = "a non-negative number";
+    } else if (lo == -kInf && hi == kInf) {
+      requirement = "a finite number";
+    } else {
+      requirement = "a number in [" + formatNumber(lo) + ", " + formatNumber(hi) + "]";
+      if (positive) requirement += " and > 0";
+    }
+    if (allow_inf) requirement += " (or .inf)";
+    double number = 0.0;
+    if (value.getType() == XmlRpcValue::TypeInt) {
+      number = static_cast<int>(value);
+    } else if (value.getType() == XmlRpcValue::TypeDouble) {
+      number = static_cast<double>(value);
+    } else {
+      fail(path, requirement, describe(value));
+      return;
+    }
+    const bool inf_ok = allow_inf && std::isinf(number) && number > 0.0;
+    if (std::isnan(number) || (!std::isfinite(number) && !inf_ok) || number < lo || number > hi ||
+        (positive && number <= 0.0)) {
+      fail(path, requirement, describe(value));
+      return;
+    }
+    *out = number;
+  }
+
+  void positiveNumber(const std::string& path, double* out) { number(path, out, 0.0, kInf, true); }
+  void nonNegativeNumber(const std::string& path, double* out) { number(path, out, 0.0, kInf); }
+  void fraction(const std::string& path, double* out) { number(path, out, 0.0, 1.0); }
+
+  /// An integer within [lo, hi].
+  void integer(const std::string& path, int* out, int lo, int hi) {
+    XmlRpcValue value;
+    if (!find(path, &value)) return;
+    std::string requirement;
+    if (lo == 1 && hi == std::numeric_limits<int>::max()) {
+      requirement = "a positive integer";
+    } else if (lo == 0 && hi == std::numeric_limits<int>::max()) {
+      requirement = "a non-negative integer";
+    } else {
+      requirement = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    }
+    if (value.getType() != XmlRpcValue::TypeInt) {
+      fail(path, requirement, describe(value));
+      return;
+    }
+    const int number = static_cast<int>(value);
+    if (number < lo || number > hi) {
+      fail(path, requirement, describe(value));
+      return;
+    }
+    *out = number;
+  }
+  void positiveInteger(const std::string& path, int* out) {
+    integer(path, out, 1, std::numeric_limits<int>::max());
+  }
+
+  void boolean(const std::string& path, bool* out) {
+    XmlRpcValue value;
+    if (!find(path, &value)) return;
+    if (value.getType() != XmlRpcValue::TypeBoolean) {
+      fail(path, "true or false", describe(value));
+      return;
+    }
+    *out = static_cast<bool>(value);
+  }
+
+  /// A non-empty string.
+  bool string(const std::string& path, std::string* out) {
+    XmlRpcValue value;
+    if (!find(path, &value)) return false;
+    if (value.getType() != XmlRpcValue::TypeString || static_cast<std::string>(value).empty()) {
+      fail(path, "a non-empty string", describe(value));
+      return false;
+    }
+    *out = static_cast<std::string>(value);
+    return true;
+  }
+
+  /// Leaf paths present in the tree but never read (typos), skipping the given top-level keys.
+  std::vector<std::string> unknownPaths(const std::set<std::string>& skipped_top_level) const {
+    std::vector<std::string> unknown;
+    collect(root_, "", skipped_top_level, &unknown);
+    return unknown;
+  }
+
+ private:
+  void collect(const XmlRpcValue& node, const std::string& path, const std::set<std::string>& skipped,
+               std::vector<std::string>* unknown) const {
+    if (node.getType() != XmlRpcValue::TypeStruct) {
+      if (!path.empty() && known_.count(path) == 0) unknown->push_back(prefix_ + path);
+      return;
+    }
+    if (!path.empty() && known_.count(path) != 0) return;  // a known key holding a dictionary
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      if (path.empty() && skipped.count(it->first) != 0) continue;
+      collect(it->second, path.empty() ? it->first : path + "/" + it->first, skipped, unknown);
+    }
+  }
+
+  XmlRpcValue root_;
+  std::string prefix_;
+  std::string* error_;
+  bool failed_ = false;
+  std::set<std::string> known_;
+};
+
+/// Reads every option except ~preset itself (which selects the starting point). Used for the
+/// ~presets/<name> subtree and for the top level alike.
+void readOptions(ParamTree& tree, LaserOdometryOptions* options) {
+  hglasm::TrackerOptions& tracker = options->tracker;
+  hglasm::MatcherOptions& matcher = tracker.matcher;
+
+  std::string algorithm_name;
+  if (tree.string("algorithm", &algorithm_name) &&
+      !hglasm::parseAlgorithm(algorithm_name, &matcher.algorithm)) {
+    tree.fail("algorithm", "one of hglasm_g, hglasm_binary, glasm_g, glasm_binary, mbicp",
+              "string \"" + algorithm_name + "\"");
+  }
+
+  // Frames, topics' behaviour, queue.
+  std::string frame;
+  if (tree.string("odom_frame", &frame)) options->odom_frame = stripLeadingSlash(frame);
+  if (tree.string("base_frame", &frame)) options->base_frame = stripLeadingSlash(frame);
+  tree.boolean("publish_tf", &options->publish_tf);
+  tree.boolean("use_odom", &options->use_odom);
+  tree.integer("path_length", &options->path_length, 0, 1000000);
+  tree.integer("queue_size", &options->queue_size, 1, 10000);
+  tree.boolean("publish_population", &options->publish_population);
+  tree.positiveNumber("tf_warn_period", &options->tf_warn_period);
+
+  // Keyframes and failure policy.
+  tree.positiveNumber("keyframe/distance", &tracker.keyframe_distance);
+  tree.number("keyframe/angle", &tracker.keyframe_angle, 0.0, M_PI, true);
+  tree.fraction("keyframe/min_fitness", &tracker.keyframe_min_fitness);
+  tree.fraction("min_fitness", &tracker.min_fitness);
+  tree.positiveInteger("min_points", &tracker.min_points);
+  tree.number("fallback_covariance_scale", &tracker.fallback_covariance_scale, 1.0, 1e12);
+  tree.positiveNumber("max_time_jump", &tracker.max_time_jump);
+
+  // Matches far from the prediction (a GA leap to a look-alike place) must prove themselves.
+  tree.nonNegativeNumber("jump/distance", &tracker.jump_distance);
+  tree.number("jump/angle", &tracker.jump_angle, 0.0, M_PI);
+  tree.nonNegativeNumber("jump/fraction", &tracker.jump_fraction);
+  tree.fraction("jump/margin", &tracker.jump_margin);
+  tree.nonNegativeNumber("jump/min_relative_fitness", &tracker.jump_min_relative_fitness);
+
+  // Wheel odometry as the prediction.
+  tree.nonNegativeNumber("odometry/max_extrapolation", &tracker.odometry_max_extrapolation);
+  tree.nonNegativeNumber("odometry/noise_xy", &tracker.odometry_noise_xy);
+  tree.nonNegativeNumber("odometry/noise_theta", &tracker.odometry_noise_theta);
+  tree.positiveNumber("odometry/max_speed", &tracker.max_odometry_speed);
+  tree.positiveNumber("odometry/max_turn_rate", &tracker.max_odometry_turn_rate);
+  tree.number("odometry/wait", &options->odometry_wait, 0.0, 10.0);
+
+  // Scan conversion.
+  tree.nonNegativeNumber("scan/min_range", &tracker.conversion.min_range);
+  tree.number("scan/max_range", &tracker.conversion.max_range, 0.0, kInf, true, true);
+  tree.integer("scan/beam_step", &tracker.conversion.beam_step, 1, 100);
+
+  // Lookup tables (the fine one, and the coarse one of the first GA generations).
+  for (const char* name : {"table", "coarse_table"}) {
+    hglasm::LookupTableOptions& table = std::string(name) == "table" ? matcher.table : matcher.coarse_table;
+    const std::string prefix = std::string(name) + "/";
+    tree.positiveNumber(prefix + "cell_size", &table.cell_size);
+    tree.positiveNumber(prefix + "sigma", &table.sigma);
+    tree.positiveNumber(prefix + "cutoff", &table.cutoff);
+    tree.number(prefix + "segment_max_gap", &table.segment_max_gap, 0.0, kInf);
+    tree.nonNegativeNumber(prefix + "segment_gap_per_metre", &table.segment_gap_per_metre);
+  }
+
+  // Genetic pre-alignment.
+  hglasm::GeneticOptions& genetic = matcher.genetic;
+  tree.positiveNumber("genetic/box_x", &genetic.box.half_x);
+  tree.positiveNumber("genetic/box_y", &genetic.box.half_y);
+  tree.number("genetic/box_theta", &genetic.box.half_theta, 0.0, M_PI, true);
+  tree.integer("genetic/population", &genetic.population, 2, 100000);
+  tree.positiveInteger("genetic/generations", &genetic.generations);
+  tree.positiveInteger("genetic/runs", &genetic.runs);
+  tree.integer("genetic/bits_per_gene", &genetic.bits_per_gene, 2, 20);
+  tree.fraction("genetic/crossover_rate", &genetic.crossover_rate);
+  tree.fraction("genetic/mutation_rate", &genetic.mutation_rate);
+  tree.positiveInteger("genetic/tournament_size", &genetic.tournament_size);
+  tree.integer("genetic/elite_count", &genetic.elite_count, 0, 100000);
+  tree.integer("genetic/max_points", &genetic.max_points, 0, 1000000);
+  tree.integer("genetic/polish_evaluations", &genetic.polish_evaluations, 0, 1000000);
+  tree.integer("genetic/coarse_generations", &genetic.coarse_generations, 0, 100000);
+  int seed = static_cast<int>(genetic.seed);
+  tree.integer("genetic/seed", &seed, 0, std::numeric_limits<int>::max());
+  genetic.seed = static_cast<std::uint64_t>(seed);
+
+  // MbICP refinement.
+  hglasm::MbicpOptions& mbicp = matcher.mbicp;
+  tree.positiveNumber("mbicp/metric_l", &mbicp.metric_l);
+  tree.number("mbicp/bearing_window", &mbicp.bearing_window, 0.0, M_PI, true);
+  tree.positiveNumber("mbicp/max_distance", &mbicp.max_distance);
+  tree.nonNegativeNumber("mbicp/fine_max_distance", &mbicp.fine_max_distance);
+  tree.nonNegativeNumber("mbicp/settle_step_xy", &mbicp.settle_step_xy);
+  tree.nonNegativeNumber("mbicp/settle_step_theta", &mbicp.settle_step_theta);
+  tree.nonNegativeNumber("mbicp/segment_max_gap", &mbicp.segment_max_gap);
+  tree.nonNegativeNumber("mbicp/segment_gap_per_metre", &mbicp.segment_gap_per_metre);
+  tree.boolean("mbicp/point_to_line", &mbicp.point_to_line);
+  tree.number("mbicp/trim_fraction", &mbicp.trim_fraction, 0.0, 1.0, true);
+  tree.positiveInteger("mbicp/max_iterations", &mbicp.max_iterations);
+  tree.nonNegativeNumber("mbicp/error_ratio", &mbicp.error_ratio);
+  tree.nonNegativeNumber("mbicp/min_step_xy", &mbicp.min_step_xy);
+  tree.nonNegativeNumber("mbicp/min_step_theta", &mbicp.min_step_theta);
+  tree.positiveInteger("mbicp/converged_iterations", &mbicp.converged_iterations);
+  tree.fraction("mbicp/min_association_ratio", &mbicp.min_association_ratio);
+  tree.fraction("mbicp/degenerate_eigenvalue", &mbicp.degenerate_eigenvalue);
+
+  // Diagnostics.
+  tree.nonNegativeNumber("diagnostics/min_rate", &options->diagnostics.min_rate);
+  tree.fraction("diagnostics/warn_failure_ratio", &options->diagnostics.warn_failure_ratio);
+  tree.fraction("diagnostics/error_failure_ratio", &options->diagnostics.error_failure_ratio);
+  tree.positiveNumber("diagnostics/window", &options->diagnostics.window);
+  tree.positiveNumber("diagnostics/period", &options->diagnostics.period);
+}
+
+/// Constraints between parameters, checked once all layers are applied.
+bool checkConsistency(const LaserOdometryOptions& options, std::string* error) {
+  auto fail = [error](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  const hglasm::GeneticOptions& genetic = options.tracker.matcher.genetic;
+  if (genetic.elite_count >= genetic.population) {
+    return fail("parameter ~genetic/elite_count must be less than ~genetic/population (" +
+                std::to_string(genetic.population) + "), got " + std::to_string(genetic.elite_count));
+  }
+  if (genetic.coarse_generations > genetic.generations) {
+    return fail("parameter ~genetic/coarse_generations must not exceed ~genetic/generations (" +
+                std::to_string(genetic.generations) + "), got " + std::to_string(genetic.coarse_generations));
+  }
+  if (genetic.tournament_size > genetic.population) {
+    return fail("parameter ~genetic/tournament_size must not exceed ~genetic/population (" +
+                std::to_string(genetic.population) + "), got " + std::to_string(genetic.tournament_size));
+  }
+  const hglasm::ScanConversionOptions& conversion = options.tracker.conversion;
+  if (conversion.max_range <= conversion.min_range) {
+    return fail("parameter ~scan/max_range must be greater than ~scan/min_range (" +
+                formatNumber(conversion.min_range) + "), got " + formatNumber(conversion.max_range));
+  }
+  if (options.diagnostics.error_failure_ratio < options.diagnostics.warn_failure_ratio) {
+    return fail(
+        "parameter ~diagnostics/error_failure_ratio must be at least ~diagnostics/warn_failure_ratio (" +
+        formatNumber(options.diagnostics.warn_failure_ratio) + "), got " +
+        formatNumber(options.diagnostics.error_failure_ratio));
+  }
+  if (options.odom_frame.empty() || options.base_frame.empty() || options.odom_frame == options.base_frame) {
+    return fail("parameter ~base_frame must differ from ~odom_frame and neither may be \"/\", got \"" +
+                options.base_frame + "\" and \"" + options.odom_frame + "\"");
+  }
+  return true;
+}
+
+}  // namespace
+
+bool loadOptions(const XmlRpcValue& private_params, LaserOdometryOptions* options, std::string* error,
+                 std::vector<std::string>* warnings) {
+  // An invalid (empty) value means no parameters at all: every default applies.
+  const XmlRpcValue& root = private_params;
+  if (root.getType() != XmlRpcValue::TypeStruct && root.getType() != XmlRpcValue::TypeInvalid) {
+    if (error) *error = "the private namespace must hold a dictionary of parameters, got " + describe(root);
+    return false;
+  }
+  std::string top_error;
+  ParamTree top(root, "~", &top_error);
+
+  *options = LaserOdometryOptions();
+
+  // 1. The preset's built-in values.
+  std::string preset_name = options->preset;
+  top.string("preset", &preset_name);
+  if (top.failed()) {
+    if (error) *error = top_error;
+    return false;
+  }
+  XmlRpcValue presets;
+  const bool has_presets = top.find("presets", &presets);
+  if (has_presets && presets.getType() != XmlRpcValue::TypeStruct) {
+    if (error) *error = "parameter ~presets must be a dictionary of presets, got " + describe(presets);
+    return false;
+  }
+  const bool preset_in_yaml = has_presets && presets.hasMember(preset_name);
+  hglasm::Preset builtin = hglasm::Preset::kMedium;
+  const bool preset_builtin = hglasm::parsePreset(preset_name, &builtin);
+  if (!preset_builtin && !preset_in_yaml) {
+    if (error) {
+      *error =
+          "parameter ~preset must be one of small, medium, large (or a preset defined under ~presets), "
+          "got string \"" +
+          preset_name + "\"";
+    }
+    return false;
+  }
+  options->preset = preset_name;
+  options->tracker.matcher = hglasm::presetOptions(builtin);
+
+  // 2. ~presets/<name> from config/presets.yaml.
+  if (preset_in_yaml) {
+    XmlRpcValue preset_tree = presets[preset_name];
+    if (preset_tree.getType() != XmlRpcValue::TypeStruct) {
+      if (error)
+        *error = "parameter ~presets/" + preset_name + " must be a dictionary, got " + describe(preset_tree);
+      return false;
+    }
+    std::string preset_error;
+    ParamTree preset_params(preset_tree, "~presets/" + preset_name + "/", &preset_error);
+    readOptions(preset_params, options);
+    if (preset_params.failed()) {
+      if (error) *error = preset_error;
+      return false;
+    }
+    if (warnings) {
+      for (const std::string& path : preset_params.unknownPaths({})) {
+        warnings->push_back("unknown parameter " + path + " (ignored)");
+      }
+    }
+  }
+
+  // 3. Top-level overrides.
+  readOptions(top, options);
+  if (top.failed()) {
+    if (error) *error = top_error;
+    return false;
+  }
+  options->tracker.use_odometry = options->use_odom;
+  if (!checkConsistency(*options, error)) return false;
+
+  if (warnings) {
+    // diagnostic_period belongs to diagnostic_updater, which reads it from the same namespace.
+    for (const std::string& path : top.unknownPaths({"presets", "diagnostic_period"})) {
+      warnings->push_back("unknown parameter " + path + " (ignored)");
+    }
+  }
+  return true;
+}
+
+bool loadOptions(const ros::NodeHandle& private_nh, LaserOdometryOptions* options, std::string* error,
+                 std::vector<std::string>* warnings) {
+  XmlRpcValue params;
+  if (!private_nh.getParam(private_nh.getNamespace(), params)) params = XmlRpcValue();
+  return loadOptions(params, options, error, warnings);
+}
+
+std::string summarize(const LaserOdometryOptions& options) {
+  const hglasm::MatcherOptions& matcher = options.tracker.matcher;
+  const hglasm::GeneticOptions& genetic = matcher.genetic;
+  std::ostringstream out;
+  out << "preset " << options.preset << ", algorithm " << hglasm::toString(matcher.algorithm) << ", box +-"
+      << genetic.box.half_x << " m x +-" << genetic.box.half_y << " m x +-" << genetic.box.half_theta
+      << " rad, GA " << genetic.population << "x" << genetic.generations << "x" << genetic.runs << ", cell "
+      << matcher.table.cell_size << " m, keyframe " << options.tracker.keyframe_distance << " m / "
+      << options.tracker.keyframe_angle << " rad, " << options.odom_frame << " -> " << options.base_frame
+      << (options.publish_tf ? " (tf)" : " (no tf)")
+      << (options.use_odom ? ", wheel odometry in" : ", no wheel odometry") << ", queue "
+      << options.queue_size;
+  return out.str();
+}
+
+}  // namespace hglasm_odometry

@@ -1,0 +1,300 @@
+// demo_report: the demo's live reporter. Connects to the running laser odometry, resumes the paused bag
+// player once everything is connected, prints progress while the bag plays, then a summary (scans
+// processed, time per scan from ~match, fallbacks, accuracy against reference relations next to the bag's
+// wheel odometry), and writes the trajectories plus a gnuplot script for the plot.
+//
+//   demo_report --bag B [--relations R] [--output-dir DIR] [--odom-topic T] [--match-topic T]
+//               [--player /player] [--timeout SEC]
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <std_srvs/SetBool.h>
+
+#include "hglasm_odometry/Match.h"
+#include "hglasm_odometry/core/odometry_buffer.h"
+#include "hglasm_odometry/core/relations.h"
+#include "hglasm_odometry/ros/conversions.h"
+
+namespace {
+
+struct Options {
+  std::string bag;
+  std::string relations;
+  std::string output_dir = "output";
+  std::string scan_topic = "/scan";
+  std::string wheel_odom_topic = "/odom";
+  std::string odom_topic = "/laser_odometry/odom";
+  std::string match_topic = "/laser_odometry/match";
+  std::string player = "/player";
+  double timeout = 600.0;  // wall seconds
+};
+
+const char kUsage[] =
+    "usage: demo_report --bag B [--relations R] [--output-dir DIR] [--odom-topic T] [--match-topic T]\n"
+    "                   [--player /player] [--timeout SEC]\n";
+
+bool parseArguments(const std::vector<std::string>& args, Options* options) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (i + 1 >= args.size()) return false;
+    const std::string& value = args[++i];
+    if (arg == "--bag") {
+      options->bag = value;
+    } else if (arg == "--relations") {
+      options->relations = value;
+    } else if (arg == "--output-dir") {
+      options->output_dir = value;
+    } else if (arg == "--odom-topic") {
+      options->odom_topic = value;
+    } else if (arg == "--match-topic") {
+      options->match_topic = value;
+    } else if (arg == "--player") {
+      options->player = value;
+    } else if (arg == "--timeout") {
+      options->timeout = std::atof(value.c_str());
+    } else {
+      return false;
+    }
+  }
+  return !options->bag.empty();
+}
+
+struct Received {
+  std::mutex mutex;
+  std::vector<nav_msgs::Odometry> odometry;
+  std::vector<hglasm_odometry::Match> matches;
+};
+
+double percentile(std::vector<double> values, double fraction) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const std::size_t index =
+      std::min(values.size() - 1, static_cast<std::size_t>(fraction * (values.size() - 1) + 0.5));
+  return values[index];
+}
+
+void printAccuracyRow(const char* label, const hglasm::RelationStats& laser,
+                      const hglasm::RelationStats& wheel) {
+  std::printf("    %-12s %4d   %7.4f m %7.3f deg     %7.4f m %7.3f deg\n", label, laser.count,
+              laser.trans_mean, laser.rot_mean_deg, wheel.trans_mean, wheel.rot_mean_deg);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "demo_report", ros::init_options::AnonymousName);
+  Options options;
+  if (!parseArguments(std::vector<std::string>(argv + 1, argv + argc), &options)) {
+    std::cerr << kUsage;
+    return 2;
+  }
+
+  // The bag: its scan stamps (what must come out) and wheel odometry (for comparison).
+  std::vector<double> scan_stamps;
+  hglasm::OdometryBuffer wheel(1e9);
+  try {
+    rosbag::Bag bag(options.bag, rosbag::bagmode::Read);
+    for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+      if (m.getTopic() == options.scan_topic) {
+        if (auto scan = m.instantiate<sensor_msgs::LaserScan>())
+          scan_stamps.push_back(scan->header.stamp.toSec());
+      } else if (m.getTopic() == options.wheel_odom_topic) {
+        auto odom = m.instantiate<nav_msgs::Odometry>();
+        hglasm::Pose2D pose;
+        if (odom && hglasm_odometry::pose2DFromOdometryMsg(*odom, &pose))
+          wheel.add(odom->header.stamp.toSec(), pose);
+      }
+    }
+  } catch (const rosbag::BagException& ex) {
+    std::cerr << "demo_report: " << ex.what() << "\n";
+    return 1;
+  }
+  std::sort(scan_stamps.begin(), scan_stamps.end());
+  const std::size_t expected = scan_stamps.size();
+
+  ros::NodeHandle nh;
+  Received received;
+  ros::Subscriber odom_sub = nh.subscribe<nav_msgs::Odometry>(
+      options.odom_topic, 10000, [&received](const nav_msgs::OdometryConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(received.mutex);
+        received.odometry.push_back(*msg);
+      });
+  ros::Subscriber match_sub = nh.subscribe<hglasm_odometry::Match>(
+      options.match_topic, 10000, [&received](const hglasm_odometry::MatchConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(received.mutex);
+        received.matches.push_back(*msg);
+      });
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+
+  std::printf("[demo] waiting for the laser odometry (%s) ...\n", options.odom_topic.c_str());
+  std::fflush(stdout);
+  const ros::WallTime start = ros::WallTime::now();
+  while (ros::ok() && (odom_sub.getNumPublishers() == 0 || match_sub.getNumPublishers() == 0)) {
+    if ((ros::WallTime::now() - start).toSec() > 60.0) {
+      std::cerr << "demo_report: the laser odometry did not come up within 60 s\n";
+      return 1;
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+  const std::string pause_service = options.player + "/pause_playback";
+  if (!ros::service::waitForService(pause_service, ros::Duration(60.0))) {
+    std::cerr << "demo_report: no " << pause_service << " service (is the player running paused?)\n";
+    return 1;
+  }
+  std_srvs::SetBool resume;
+  resume.request.data = false;
+  ros::service::call(pause_service, resume);
+  std::printf("[demo] playing %zu scans of %s\n", expected, options.bag.c_str());
+  std::fflush(stdout);
+
+  // Progress until every scan has come out, nothing arrives for 20 s, or the time is up.
+  std::size_t last_count = 0, last_reported = 0;
+  ros::WallTime last_progress = ros::WallTime::now();
+  while (ros::ok() && (ros::WallTime::now() - start).toSec() < options.timeout) {
+    std::size_t count, fallbacks = 0;
+    double ms = 0.0;
+    {
+      std::lock_guard<std::mutex> lock(received.mutex);
+      count = std::min(received.odometry.size(), received.matches.size());
+      for (const auto& m : received.matches) {
+        fallbacks += m.fallback && m.matched;
+        ms += m.total_ms;
+      }
+      if (!received.matches.empty()) ms /= received.matches.size();
+    }
+    if (count >= last_reported + std::max<std::size_t>(1, expected / 10) ||
+        (count >= expected && count != last_reported)) {
+      std::printf("[demo] %4zu / %zu scans (%3.0f %%), %.2f ms per scan, %zu fallbacks\n", count, expected,
+                  100.0 * count / std::max<std::size_t>(1, expected), ms, fallbacks);
+      std::fflush(stdout);
+      last_reported = count;
+    }
+    if (count >= expected) break;
+    if (count != last_count) {
+      last_count = count;
+      last_progress = ros::WallTime::now();
+    } else if ((ros::WallTime::now() - last_progress).toSec() > 20.0) {
+      std::printf("[demo] no output for 20 s; stopping at %zu of %zu scans\n", count, expected);
+      break;
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+  ros::WallDuration(0.3).sleep();
+  spinner.stop();
+  const double wall = (ros::WallTime::now() - start).toSec();
+
+  std::lock_guard<std::mutex> lock(received.mutex);
+  std::vector<hglasm::StampedPose> trajectory;
+  for (const auto& odom : received.odometry) {
+    hglasm::StampedPose pose;
+    pose.stamp = odom.header.stamp.toSec();
+    if (hglasm_odometry::pose2DFromOdometryMsg(odom, &pose.pose)) trajectory.push_back(pose);
+  }
+  std::sort(trajectory.begin(), trajectory.end(),
+            [](const hglasm::StampedPose& a, const hglasm::StampedPose& b) { return a.stamp < b.stamp; });
+  // Wheel odometry at the same stamps, started at the laser odometry's first pose for the plot.
+  std::vector<hglasm::StampedPose> wheel_trajectory;
+  hglasm::Pose2D wheel_origin, laser_origin = trajectory.empty() ? hglasm::Pose2D() : trajectory.front().pose;
+  bool have_origin = false;
+  for (double stamp : scan_stamps) {
+    hglasm::StampedPose pose;
+    pose.stamp = stamp;
+    if (!wheel.poseAt(stamp, 1.0, &pose.pose)) continue;
+    if (!have_origin) {
+      wheel_origin = pose.pose;
+      have_origin = true;
+    }
+    wheel_trajectory.push_back(pose);
+  }
+
+  std::vector<double> total_ms;
+  std::size_t fallbacks = 0, matched = 0, keyframes = 0;
+  std::uint32_t dropped = 0;
+  for (const auto& m : received.matches) {
+    total_ms.push_back(m.total_ms);
+    matched += m.matched;
+    fallbacks += m.matched && m.fallback;
+    keyframes += m.new_keyframe;
+    dropped = std::max(dropped, m.dropped_scans);
+  }
+  double mean_ms = 0.0;
+  for (double v : total_ms) mean_ms += v;
+  if (!total_ms.empty()) mean_ms /= total_ms.size();
+
+  std::printf("\n================ hglasm_odometry demo summary ================\n");
+  std::printf("  bag                 %s\n", options.bag.c_str());
+  std::printf("  scans processed     %zu of %zu (%u dropped by the input queue), %.1f s wall\n",
+              received.odometry.size(), expected, dropped, wall);
+  std::printf(
+      "  time per scan       mean %.2f ms, median %.2f ms, p95 %.2f ms, max %.2f ms (~match total_ms)\n",
+      mean_ms, percentile(total_ms, 0.5), percentile(total_ms, 0.95), percentile(total_ms, 1.0));
+  std::printf("  fallbacks           %zu of %zu matches (%.1f %%)\n", fallbacks, matched,
+              matched ? 100.0 * fallbacks / matched : 0.0);
+  std::printf("  keyframes           %zu\n", keyframes);
+
+  int status = received.odometry.size() == expected ? 0 : 1;
+  if (!options.relations.empty()) {
+    std::vector<hglasm::Relation> relations;
+    std::string error;
+    if (!hglasm::readRelations(options.relations, &relations, &error)) {
+      std::printf("  accuracy            cannot read %s: %s\n", options.relations.c_str(), error.c_str());
+    } else {
+      std::printf("  accuracy vs %zu reference relations (Kümmerle et al. 2009), mean error:\n",
+                  relations.size());
+      std::printf("    %-12s %4s   %-23s   %s\n", "relations", "n", "laser odometry", "wheel odometry (bag)");
+      printAccuracyRow("all", hglasm::evaluateRelations(relations, trajectory, 0.0),
+                       hglasm::evaluateRelations(relations, wheel_trajectory, 0.0));
+      printAccuracyRow("<= 10 s", hglasm::evaluateRelations(relations, trajectory, 10.0),
+                       hglasm::evaluateRelations(relations, wheel_trajectory, 10.0));
+    }
+  }
+
+  // Trajectories and the gnuplot script of the plot.
+  const std::string dir = options.output_dir;
+  {
+    std::ofstream out(dir + "/trajectory.txt");
+    out << "# laser odometry: stamp x y theta (base_link in odom)\n";
+    for (const auto& p : trajectory)
+      out << std::fixed << p.stamp << " " << p.pose.x << " " << p.pose.y << " " << p.pose.theta << "\n";
+  }
+  {
+    std::ofstream out(dir + "/wheel_odometry.txt");
+    out << "# wheel odometry of the bag at the scan stamps, started at the laser odometry's first pose\n";
+    for (const auto& p : wheel_trajectory) {
+      const hglasm::Pose2D aligned = laser_origin * hglasm::relativePose(wheel_origin, p.pose);
+      out << std::fixed << p.stamp << " " << aligned.x << " " << aligned.y << " " << aligned.theta << "\n";
+    }
+  }
+  {
+    std::ofstream out(dir + "/trajectory.gp");
+    out << "set terminal pngcairo size 1000,900 font 'Sans,11' noenhanced\n"
+        << "set output '" << dir << "/trajectory.png'\n"
+        << "set title 'hglasm_odometry on " << options.bag.substr(options.bag.find_last_of('/') + 1)
+        << ": laser odometry vs wheel odometry (from the bag)'\n"
+        << "set xlabel 'x (m)'\nset ylabel 'y (m)'\nset size ratio -1\nset grid\nset key below\n"
+        << "plot '" << dir
+        << "/wheel_odometry.txt' using 2:3 with lines lw 1.5 lc rgb '#999999' title 'wheel odometry', \\\n"
+        << "     '" << dir
+        << "/trajectory.txt' using 2:3 with lines lw 2 lc rgb '#d62728' title 'laser odometry (HGLASM-g)', "
+           "\\\n"
+        << "     '" << dir
+        << "/trajectory.txt' every ::0::0 using 2:3 with points pt 7 ps 1.5 lc rgb 'black' title 'start'\n";
+  }
+  std::printf("  trajectory          %s/trajectory.txt (plot script %s/trajectory.gp)\n", dir.c_str(),
+              dir.c_str());
+  std::printf("===============================================================\n");
+  return status;
+}

@@ -1,0 +1,546 @@
+// evaluate: runs the nodelet's odometry pipeline (hglasm::OdometryTracker, same options and YAML)
+// over a bag as fast as the CPU allows, without a ROS master, and scores it on the Kümmerle et al.
+// relations benchmark next to the bag's raw wheel odometry.
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "hglasm_odometry/core/odometry_tracker.h"
+#include "hglasm_odometry/core/relations.h"
+#include "hglasm_odometry/core/scan.h"
+#include "hglasm_odometry/core/scan_matcher.h"
+#include "hglasm_odometry/ros/bag_reader.h"
+#include "hglasm_odometry/ros/parameters.h"
+
+#include <xmlrpcpp/XmlRpcValue.h>
+
+namespace {
+
+const char kUsage[] =
+    "usage: evaluate --bag B [options]\n"
+    "  --bag B                 bag with sensor_msgs/LaserScan (+ nav_msgs/Odometry, /tf_static)\n"
+    "  --scan-topic T          default /scan\n"
+    "  --odom-topic T          default /odom\n"
+    "  --config Y              default <package>/config/laser_odometry.yaml (the nodelet's parameters)\n"
+    "  --presets Y             default presets.yaml next to --config (loaded under ~presets)\n"
+    "  --preset P              small | medium | large or a preset of --presets (default: the YAML's)\n"
+    "  --relations R           Kümmerle et al. relations file: print the benchmark metric\n"
+    "  --out F                 write the trajectory, 'stamp x y theta' per scan (base frame)\n"
+    "  --plot F.png            plot laser and wheel odometry trajectories (gnuplot)\n"
+    "  --no-odom               do not feed wheel odometry to the tracker (constant-velocity prior)\n"
+    "  --odom-lookahead S      feed odometry stamped up to S s after each scan (default 0: as live)\n"
+    "  --min-scan-interval S   skip scans stamped less than S s after the last processed one\n"
+    "  --laser-mount X,Y,YAW   base -> laser (m, m, rad) instead of the bag's tf\n"
+    "  --max-scans N           process only the first N scans\n"
+    "  --angle-increment A     override the scans' angle increment (radians)\n"
+    "  --angle-min A           override the scans' first beam angle (radians)\n"
+    "  --max-span S            short-relation span for the second metric row (default 10 s)\n"
+    "  --quiet                 no per-warning output\n";
+
+struct Arguments {
+  std::string bag;
+  std::string scan_topic = "/scan";
+  std::string odom_topic = "/odom";
+  std::string config = HGLASM_SOURCE_DIR "/config/laser_odometry.yaml";
+  bool config_given = false;
+  std::string presets;
+  bool presets_given = false;
+  std::string preset;
+  std::string relations;
+  std::string out;
+  std::string plot;
+  bool use_odometry = true;
+  double odom_lookahead = 0.0;
+  double min_scan_interval = 0.0;
+  bool override_mount = false;
+  hglasm::Pose2D laser_mount;
+  std::size_t max_scans = 0;
+  bool override_increment = false;
+  double angle_increment = 0.0;
+  bool override_angle_min = false;
+  double angle_min = 0.0;
+  double short_span = 10.0;
+  bool quiet = false;
+};
+
+bool parseArguments(int argc, char** argv, Arguments* args) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    const auto value = [&](std::string* out) {
+      if (i + 1 >= argc) {
+        std::cerr << "evaluate: " << flag << " needs a value\n";
+        return false;
+      }
+      *out = argv[++i];
+      return true;
+    };
+    const auto number = [&](double* out) {
+      std::string text;
+      if (!value(&text)) return false;
+      char* end = nullptr;
+      *out = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(*out)) {
+        std::cerr << "evaluate: " << flag << ": not a number: '" << text << "'\n";
+        return false;
+      }
+      return true;
+    };
+    double parsed = 0.0;
+    if (flag == "--help" || flag == "-h") {
+      std::cout << kUsage;
+      std::exit(0);
+    } else if (flag == "--bag") {
+      if (!value(&args->bag)) return false;
+    } else if (flag == "--scan-topic") {
+      if (!value(&args->scan_topic)) return false;
+    } else if (flag == "--odom-topic") {
+      if (!value(&args->odom_topic)) return false;
+    } else if (flag == "--config") {
+      if (!value(&args->config)) return false;
+      args->config_given = true;
+    } else if (flag == "--presets") {
+      if (!value(&args->presets)) return false;
+      args->presets_given = true;
+    } else if (flag == "--preset") {
+      if (!value(&args->preset)) return false;
+    } else if (flag == "--relations") {
+      if (!value(&args->relations)) return false;
+    } else if (flag == "--out") {
+      if (!value(&args->out)) return false;
+    } else if (flag == "--plot") {
+      if (!value(&args->plot)) return false;
+    } else if (flag == "--no-odom") {
+      args->use_odometry = false;
+    } else if (flag == "--quiet") {
+      args->quiet = true;
+    } else if (flag == "--max-scans") {
+      if (!number(&parsed) || parsed < 0) return false;
+      args->max_scans = static_cast<std::size_t>(parsed);
+    } else if (flag == "--angle-increment") {
+      if (!number(&args->angle_increment)) return false;
+      args->override_increment = true;
+    } else if (flag == "--odom-lookahead") {
+      if (!number(&args->odom_lookahead)) return false;
+    } else if (flag == "--laser-mount") {
+      std::string text;
+      if (!value(&text)) return false;
+      double x = 0.0, y = 0.0, yaw = 0.0;
+      char trailing = 0;
+      if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &x, &y, &yaw, &trailing) != 3 ||
+          !hglasm::Pose2D(x, y, yaw).isFinite()) {
+        std::cerr << "evaluate: --laser-mount expects X,Y,YAW, got '" << text << "'\n";
+        return false;
+      }
+      args->laser_mount = hglasm::Pose2D(x, y, yaw);
+      args->override_mount = true;
+    } else if (flag == "--min-scan-interval") {
+      if (!number(&args->min_scan_interval)) return false;
+    } else if (flag == "--angle-min") {
+      if (!number(&args->angle_min)) return false;
+      args->override_angle_min = true;
+    } else if (flag == "--max-span") {
+      if (!number(&args->short_span)) return false;
+    } else {
+      std::cerr << "evaluate: unknown argument '" << flag << "'\n" << kUsage;
+      return false;
+    }
+  }
+  if (args->bag.empty()) {
+    std::cerr << "evaluate: --bag is required\n" << kUsage;
+    return false;
+  }
+  if (args->presets.empty()) {
+    const auto slash = args->config.find_last_of('/');
+    args->presets =
+        (slash == std::string::npos ? std::string() : args->config.substr(0, slash + 1)) + "presets.yaml";
+  }
+  return true;
+}
+
+/// Loads a YAML file exactly as roslaunch's <rosparam file=...> does: with rosparam's own Python
+/// loader, handed over as XML-RPC (the parameter server's wire format). Needs no master.
+bool loadYaml(const std::string& path, XmlRpc::XmlRpcValue* value, std::string* error) {
+  // The path travels in the environment, so no shell quoting is involved.
+  setenv("HGLASM_EVALUATE_YAML", path.c_str(), 1);
+  const char* command =
+      "/usr/bin/python3 -c 'import os, sys, xmlrpc.client, rosparam\n"
+      "loaded = rosparam.load_file(os.environ[\"HGLASM_EVALUATE_YAML\"])\n"
+      "params = (loaded[0][0] if loaded else None) or {}\n"
+      "sys.stdout.write(xmlrpc.client.dumps((params,), allow_none=True))' 2>&1";
+  FILE* pipe = popen(command, "r");
+  if (!pipe) {
+    *error = "cannot run /usr/bin/python3 to read " + path;
+    return false;
+  }
+  std::string xml;
+  char buffer[4096];
+  for (std::size_t n; (n = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) xml.append(buffer, n);
+  const int status = pclose(pipe);
+  const auto start = xml.find("<value>");
+  if (status != 0 || start == std::string::npos) {
+    *error = "cannot load " + path + ": " + xml.substr(xml.find_last_of('\n', xml.size() - 2) + 1);
+    return false;
+  }
+  int offset = static_cast<int>(start);
+  *value = XmlRpc::XmlRpcValue(xml, &offset);
+  if (!value->valid() || value->getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+    *error = path + " does not hold a dictionary of parameters";
+    return false;
+  }
+  return true;
+}
+
+/// The nodelet's private namespace as the launch files build it: presets.yaml under ~presets,
+/// laser_odometry.yaml at the top, then ~preset from the command line; then the nodelet's loader.
+bool loadNodeletOptions(const Arguments& args, hglasm_odometry::LaserOdometryOptions* options,
+                        std::vector<std::string>* warnings, std::string* error) {
+  // Files named on the command line must exist; absent default files mean built-in defaults.
+  const auto exists = [](const std::string& path) { return std::ifstream(path).good(); };
+  XmlRpc::XmlRpcValue root, presets;
+  if (args.config_given || exists(args.config)) {
+    if (!loadYaml(args.config, &root, error)) return false;
+  } else {
+    std::printf("config        %s not found: built-in defaults\n", args.config.c_str());
+  }
+  if (args.presets_given || exists(args.presets)) {
+    if (!loadYaml(args.presets, &presets, error)) return false;
+    // Accept a presets file written either as {small: ..} or as {presets: {small: ..}}.
+    if (presets.size() == 1 && presets.hasMember("presets")) {
+      presets = XmlRpc::XmlRpcValue(presets["presets"]);
+    }
+    root["presets"] = presets;
+  }
+  if (!args.preset.empty()) root["preset"] = args.preset;
+  return hglasm_odometry::loadOptions(root, options, error, warnings);
+}
+
+double cpuMs() {
+  timespec now{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return now.tv_sec * 1e3 + now.tv_nsec * 1e-6;
+}
+
+/// Median, 99th percentile and maximum of a sample (nearest-rank percentiles).
+struct Spread {
+  std::size_t count = 0;
+  double median = 0.0, p99 = 0.0, max = 0.0, mean = 0.0;
+};
+
+Spread spreadOf(std::vector<double> values) {
+  Spread spread;
+  spread.count = values.size();
+  if (values.empty()) return spread;
+  std::sort(values.begin(), values.end());
+  const auto rank = [&](double fraction) {
+    const std::size_t index = static_cast<std::size_t>(std::ceil(fraction * values.size()));
+    return values[std::min(values.size() - 1, index == 0 ? 0 : index - 1)];
+  };
+  spread.median = values.size() % 2 ? values[values.size() / 2]
+                                    : 0.5 * (values[values.size() / 2 - 1] + values[values.size() / 2]);
+  spread.p99 = rank(0.99);
+  spread.max = values.back();
+  double sum = 0.0;
+  for (double value : values) sum += value;
+  spread.mean = sum / values.size();
+  return spread;
+}
+
+/// Wheel odometry interpolated at `stamp` (false outside the sampled span).
+bool wheelPoseAt(const std::vector<hglasm_odometry::BagOdometry>& odometry, double stamp,
+                 hglasm::Pose2D* pose) {
+  if (odometry.empty() || stamp < odometry.front().stamp || stamp > odometry.back().stamp) return false;
+  const auto after = std::lower_bound(
+      odometry.begin(), odometry.end(), stamp,
+      [](const hglasm_odometry::BagOdometry& sample, double value) { return sample.stamp < value; });
+  if (after == odometry.begin() || after->stamp == stamp) {
+    *pose = after->pose;
+    return true;
+  }
+  const auto before = std::prev(after);
+  const double span = after->stamp - before->stamp;
+  *pose = span > 0.0 ? hglasm::interpolate(before->pose, after->pose, (stamp - before->stamp) / span)
+                     : after->pose;
+  return true;
+}
+
+bool writeTrajectory(const std::string& path, const std::vector<hglasm::StampedPose>& trajectory) {
+  std::FILE* file = std::fopen(path.c_str(), "w");
+  if (!file) return false;
+  for (const auto& pose : trajectory) {
+    std::fprintf(file, "%.6f %.6f %.6f %.6f\n", pose.stamp, pose.pose.x, pose.pose.y, pose.pose.theta);
+  }
+  return std::fclose(file) == 0;
+}
+
+/// Plots both trajectories with equal axes; the wheel one is moved so that both start at the same pose.
+bool plotTrajectories(const std::string& png, const std::string& title,
+                      const std::vector<hglasm::StampedPose>& laser,
+                      const std::vector<hglasm::StampedPose>& wheel) {
+  if (laser.empty() && wheel.empty()) return false;
+  const std::string laser_data = png + ".laser.txt";
+  const std::string wheel_data = png + ".wheel.txt";
+  std::vector<hglasm::StampedPose> aligned_wheel = wheel;
+  if (!laser.empty() && !wheel.empty()) {
+    const hglasm::Pose2D align = laser.front().pose * wheel.front().pose.inverse();
+    for (auto& pose : aligned_wheel) pose.pose = align * pose.pose;
+  }
+  if (!writeTrajectory(laser_data, laser) || !writeTrajectory(wheel_data, aligned_wheel)) return false;
+  const std::string script = png + ".gnuplot";
+  {
+    std::ofstream out(script);
+    out << "set terminal pngcairo size 1200,1000 font ',10'\n"
+        << "set output '" << png << "'\n"
+        << "set title \"" << title << "\" noenhanced\n"
+        << "set size ratio -1\nset grid\nset key top left box opaque Left\n"
+        << "set xlabel 'x (m)'\nset ylabel 'y (m)'\n"
+        << "plot ";
+    const char* separator = "";
+    if (!aligned_wheel.empty()) {
+      out << "'" << wheel_data << "' using 2:3 with lines lw 1 lc rgb '#d62728' title 'wheel odometry'";
+      separator = ", ";
+    }
+    if (!laser.empty()) {
+      out << separator << "'" << laser_data
+          << "' using 2:3 with lines lw 1 lc rgb '#1f77b4' title 'laser odometry'"
+          << ", '" << laser_data
+          << "' every ::0::0 using 2:3 with points pt 7 ps 1.5 lc rgb 'black' title 'start'";
+    }
+    out << "\n";
+  }
+  const int status = std::system(("gnuplot '" + script + "'").c_str());
+  std::remove(script.c_str());
+  std::remove(laser_data.c_str());
+  std::remove(wheel_data.c_str());
+  return status == 0;
+}
+
+void printStatsRows(const char* label, const hglasm::RelationStats& laser, const hglasm::RelationStats& wheel,
+                    bool has_wheel) {
+  std::printf("  %-9s %5d %7d | %.4f +- %.4f  %6.3f +- %6.3f", label, laser.count, laser.missing,
+              laser.trans_mean, laser.trans_std, laser.rot_mean_deg, laser.rot_std_deg);
+  if (has_wheel) {
+    std::printf(" | %.4f +- %.4f  %6.3f +- %6.3f", wheel.trans_mean, wheel.trans_std, wheel.rot_mean_deg,
+                wheel.rot_std_deg);
+  }
+  std::printf("\n  %-9s %13s | sq %.6f m2  %9.4f deg2", "", "", laser.trans_sq_mean, laser.rot_sq_mean_deg);
+  if (has_wheel) std::printf(" | sq %.6f m2  %9.4f deg2", wheel.trans_sq_mean, wheel.rot_sq_mean_deg);
+  std::printf("\n");
+}
+
+/// What one pass of the tracker over the bag produced.
+struct Run {
+  std::vector<hglasm::StampedPose> trajectory;  ///< published base poses
+  std::size_t processed = 0, skipped = 0;
+  int matched = 0, fallbacks = 0, keyframes = 0, resets = 0, conversion_errors = 0, warnings = 0;
+  std::map<std::string, int> statuses, predictions;
+  std::vector<double> total_ms, convert_ms, prealign_ms, refine_ms, table_ms;
+};
+
+/// Feeds the bag to the tracker exactly as the nodelet would: odometry stamped up to each scan first,
+/// then the scan (converted with the tracker's options, mirrored for an upside-down laser).
+Run runTracker(const Arguments& args, const hglasm::TrackerOptions& options,
+               const hglasm_odometry::BagData& data) {
+  Run run;
+  hglasm::OdometryTracker tracker(options);
+  if (data.has_laser_mount) tracker.setLaserMount(data.base_to_laser);
+  hglasm::ScanConversionOptions conversion = options.conversion;
+  if (data.laser_upside_down) conversion.mirror = !conversion.mirror;
+
+  std::size_t next_odometry = 0;
+  double last_processed_stamp = -std::numeric_limits<double>::infinity();
+  for (const auto& bag_scan : data.scans) {
+    if (bag_scan.stamp - last_processed_stamp < args.min_scan_interval) {
+      ++run.skipped;
+      continue;
+    }
+    last_processed_stamp = bag_scan.stamp;
+    if (options.use_odometry) {
+      const double odometry_until = bag_scan.stamp + args.odom_lookahead;
+      for (; next_odometry < data.odometry.size() && data.odometry[next_odometry].stamp <= odometry_until;
+           ++next_odometry) {
+        tracker.addOdometry(data.odometry[next_odometry].stamp, data.odometry[next_odometry].pose);
+      }
+    }
+    hglasm::RangeScan ranges = bag_scan.ranges;
+    if (args.override_increment) ranges.angle_increment = args.angle_increment;
+    if (args.override_angle_min) ranges.angle_min = args.angle_min;
+
+    const double start = cpuMs();
+    hglasm::ScanError scan_error = hglasm::ScanError::kNone;
+    const hglasm::Scan scan = hglasm::scanFromRanges(ranges, conversion, &scan_error);
+    const double converted = cpuMs();
+    const hglasm::TrackerUpdate update = tracker.processScan(bag_scan.stamp, scan);
+    const double end = cpuMs();
+
+    ++run.processed;
+    run.total_ms.push_back(end - start);
+    run.convert_ms.push_back(converted - start);
+    if (scan_error != hglasm::ScanError::kNone) ++run.conversion_errors;
+    if (update.matched) {
+      ++run.matched;
+      run.prealign_ms.push_back(update.match.prealign_ms);
+      run.refine_ms.push_back(update.match.refine_ms);
+      ++run.statuses[hglasm::toString(update.match.status)];
+    }
+    if (update.new_keyframe) run.table_ms.push_back(update.table_build_ms);
+    ++run.predictions[hglasm::toString(update.prediction)];
+    run.fallbacks += update.fallback;
+    run.keyframes += update.new_keyframe;
+    run.resets += update.reset;
+    if (!update.warning.empty() && ++run.warnings <= 20 && !args.quiet) {
+      std::printf("  warning at %.6f: %s\n", bag_scan.stamp, update.warning.c_str());
+    }
+    if (update.published) run.trajectory.push_back({bag_scan.stamp, update.pose});
+  }
+  return run;
+}
+
+void printRun(const Run& run, double data_seconds) {
+  const std::size_t scans = run.processed;
+  if (run.skipped) std::printf("\nskipped       %zu scans (--min-scan-interval)", run.skipped);
+  std::printf("\nscans         %zu processed, %d matched, %d keyframes, %d resets, %zu published\n", scans,
+              run.matched, run.keyframes, run.resets, run.trajectory.size());
+  std::printf("fallbacks     %d (%.2f %% of scans), conversion errors %d, warnings %d\n", run.fallbacks,
+              scans ? 100.0 * run.fallbacks / scans : 0.0, run.conversion_errors, run.warnings);
+  std::printf("match status ");
+  for (const auto& entry : run.statuses) std::printf(" %s %d", entry.first.c_str(), entry.second);
+  std::printf("\nprediction   ");
+  for (const auto& entry : run.predictions) std::printf(" %s %d", entry.first.c_str(), entry.second);
+  std::printf("\n\nms per scan                     scans   median      p99      max  mean/scan\n");
+  const auto row = [scans](const char* label, const Spread& spread) {
+    std::printf("  %-29s %6zu %8.3f %8.3f %8.3f %8.3f\n", label, spread.count, spread.median, spread.p99,
+                spread.max, scans ? spread.mean * spread.count / scans : 0.0);
+  };
+  row("scan conversion (CPU)", spreadOf(run.convert_ms));
+  row("table build, keyframes (wall)", spreadOf(run.table_ms));
+  row("pre-align GA (wall)", spreadOf(run.prealign_ms));
+  row("refine MbICP (wall)", spreadOf(run.refine_ms));
+  row("total per scan (CPU)", spreadOf(run.total_ms));
+  const double cpu_seconds = spreadOf(run.total_ms).mean * scans * 1e-3;
+  std::printf("  total = conversion + OdometryTracker::processScan (incl. table builds), one thread\n");
+  std::printf("  total CPU %.2f s for %.1f s of data: %.0fx real time\n", cpu_seconds, data_seconds,
+              cpu_seconds > 0.0 ? data_seconds / cpu_seconds : 0.0);
+}
+
+void printRelations(const Arguments& args, const std::string& preset_name, const Run& run,
+                    const std::vector<hglasm::Relation>& relations,
+                    const std::vector<hglasm::StampedPose>& wheel_trajectory) {
+  const bool has_wheel = !wheel_trajectory.empty();
+  std::printf("\nrelations     %s: %zu (Kümmerle et al. 2009; mean +- std, population)\n",
+              args.relations.c_str(), relations.size());
+  const auto laser_all = hglasm::evaluateRelations(relations, run.trajectory, 0.0);
+  const auto wheel_all = hglasm::evaluateRelations(relations, wheel_trajectory, 0.0);
+  const auto laser_short = hglasm::evaluateRelations(relations, run.trajectory, args.short_span);
+  const auto wheel_short = hglasm::evaluateRelations(relations, wheel_trajectory, args.short_span);
+  char short_label[32];
+  std::snprintf(short_label, sizeof(short_label), "<= %g s", args.short_span);
+  std::printf("  %-9s %5s %7s | %-33s", "relations", "n", "missing", "laser odometry: m, deg");
+  if (has_wheel) std::printf(" | %s", "wheel odometry: m, deg");
+  std::printf("\n");
+  printStatsRows("all", laser_all, wheel_all, has_wheel);
+  printStatsRows(short_label, laser_short, wheel_short, has_wheel);
+  // One machine-readable line for scripts/evaluate_all.sh.
+  const Spread total = spreadOf(run.total_ms);
+  const std::size_t scans = run.processed;
+  std::printf(
+      "SUMMARY preset=%s scans=%zu fallbacks=%d fallback_pct=%.3f cpu_median_ms=%.3f cpu_p99_ms=%.3f "
+      "cpu_max_ms=%.3f all_t=%.4f all_r=%.3f short_t=%.4f short_r=%.3f wheel_all_t=%.4f "
+      "wheel_all_r=%.3f wheel_short_t=%.4f wheel_short_r=%.3f\n",
+      preset_name.c_str(), scans, run.fallbacks, scans ? 100.0 * run.fallbacks / scans : 0.0, total.median,
+      total.p99, total.max, laser_all.trans_mean, laser_all.rot_mean_deg, laser_short.trans_mean,
+      laser_short.rot_mean_deg, wheel_all.trans_mean, wheel_all.rot_mean_deg, wheel_short.trans_mean,
+      wheel_short.rot_mean_deg);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Arguments args;
+  if (!parseArguments(argc, argv, &args)) return 2;
+
+  // The nodelet's options, through the nodelet's own loader.
+  hglasm_odometry::LaserOdometryOptions nodelet_options;
+  std::vector<std::string> config_warnings;
+  std::string error;
+  if (!loadNodeletOptions(args, &nodelet_options, &config_warnings, &error)) {
+    std::cerr << "evaluate: " << error << "\n";
+    return 2;
+  }
+  for (const auto& warning : config_warnings) std::printf("config        warning: %s\n", warning.c_str());
+  hglasm::TrackerOptions options = nodelet_options.tracker;
+  if (!args.use_odometry) options.use_odometry = false;
+
+  hglasm_odometry::BagReadOptions read_options;
+  read_options.scan_topic = args.scan_topic;
+  read_options.odom_topic = args.odom_topic;
+  read_options.max_scans = args.max_scans;
+  read_options.base_frame = nodelet_options.base_frame;
+  hglasm_odometry::BagData data;
+  const double read_start = cpuMs();
+  if (!hglasm_odometry::readBag(args.bag, read_options, &data, &error)) {
+    std::cerr << "evaluate: " << error << "\n";
+    return 1;
+  }
+  std::vector<hglasm::Relation> relations;
+  if (!args.relations.empty() && !hglasm::readRelations(args.relations, &relations, &error)) {
+    std::cerr << "evaluate: " << error << "\n";
+    return 1;
+  }
+  std::printf("bag           %s: %zu scans, %zu odometry samples (read in %.1f s CPU)\n", args.bag.c_str(),
+              data.scans.size(), data.odometry.size(), (cpuMs() - read_start) * 1e-3);
+  const char* mount_source = data.has_laser_mount ? "from tf" : "not found, identity";
+  if (args.override_mount) {
+    data.has_laser_mount = true;
+    data.base_to_laser = args.laser_mount;
+    mount_source = "from --laser-mount";
+  }
+  std::printf("laser mount   %s: base '%s' -> laser '%s' = (%.3f, %.3f, %.3f rad)%s\n", mount_source,
+              data.base_frame.c_str(), data.scans.front().frame_id.c_str(), data.base_to_laser.x,
+              data.base_to_laser.y, data.base_to_laser.theta,
+              data.laser_upside_down ? ", upside down (scans mirrored)" : "");
+  std::printf("options       %s, preset %s, wheel odometry %s\n", args.config.c_str(),
+              nodelet_options.preset.c_str(),
+              !options.use_odometry   ? "off"
+              : data.odometry.empty() ? "on (but none in the bag)"
+                                      : "on");
+
+  const Run run = runTracker(args, options, data);
+  printRun(run, data.scans.back().stamp - data.scans.front().stamp);
+
+  // Wheel odometry at the scan stamps: the baseline the laser must beat.
+  std::vector<hglasm::StampedPose> wheel_trajectory;
+  for (const auto& bag_scan : data.scans) {
+    hglasm::Pose2D pose;
+    if (wheelPoseAt(data.odometry, bag_scan.stamp, &pose)) wheel_trajectory.push_back({bag_scan.stamp, pose});
+  }
+  if (!relations.empty()) printRelations(args, nodelet_options.preset, run, relations, wheel_trajectory);
+
+  if (!args.out.empty()) {
+    if (!writeTrajectory(args.out, run.trajectory)) {
+      std::cerr << "evaluate: cannot write " << args.out << "\n";
+      return 1;
+    }
+    std::printf("trajectory    %s (%zu poses)\n", args.out.c_str(), run.trajectory.size());
+  }
+  if (!args.plot.empty()) {
+    const std::string title =
+        args.bag.substr(args.bag.find_last_of('/') + 1) + ", preset " + nodelet_options.preset;
+    if (!plotTrajectories(args.plot, title, run.trajectory, wheel_trajectory)) {
+      std::cerr << "evaluate: gnuplot failed for " << args.plot << "\n";
+      return 1;
+    }
+    std::printf("plot          %s\n", args.plot.c_str());
+  }
+  return 0;
+}

@@ -1,0 +1,302 @@
+// GLASM lookup tables: graded values (normal in the distance to the nearest reference point), cut-off,
+// the binary square, sparse memory, and fitness.
+#include "hglasm_odometry/core/lookup_table.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "test_util.h"
+
+namespace {
+
+using hglasm::LookupTable;
+using hglasm::LookupTableOptions;
+using hglasm::TableKind;
+using Points = std::vector<Eigen::Vector2d>;
+
+constexpr double kCell = 0.02;
+constexpr double kSigma = 0.10;
+constexpr double kCutoff = 0.30;
+
+/// The papers' point-only table: the distance is to the nearest reference point (no joining segments).
+LookupTableOptions gradedOptions() {
+  LookupTableOptions options;
+  options.kind = TableKind::kGraded;
+  options.cell_size = kCell;
+  options.sigma = kSigma;
+  options.cutoff = kCutoff;
+  options.segment_max_gap = 0.0;
+  return options;
+}
+
+LookupTableOptions binaryOptions() {
+  LookupTableOptions options = gradedOptions();
+  options.kind = TableKind::kBinary;
+  return options;
+}
+
+double normal255(double distance) { return 255.0 * std::exp(-distance * distance / (2.0 * kSigma * kSigma)); }
+
+// A reference point in the middle of a cell (away from cell borders for any rounding convention).
+const Eigen::Vector2d kCentre((37 + 0.5) * kCell, (-11 + 0.5) * kCell);
+
+std::vector<Eigen::Vector2d> linePoints(double length, double spacing) {
+  std::vector<Eigen::Vector2d> points;
+  for (double x = 0.0; x <= length + 1e-9; x += spacing) points.emplace_back(x, 0.37 * x + 1.0);
+  return points;
+}
+
+TEST(LookupTable, EmptyBeforeBuildAndForEmptyReference) {
+  LookupTable table(gradedOptions());
+  EXPECT_TRUE(table.empty());
+  EXPECT_EQ(table.valueAt(Eigen::Vector2d::Zero()), 0);
+  EXPECT_EQ(table.fitness(Points{Eigen::Vector2d::Zero()}, hglasm::Pose2D()), 0u);
+  table.build({});
+  EXPECT_TRUE(table.empty());
+  EXPECT_EQ(table.tileCount(), 0u);
+  EXPECT_EQ(table.fitness(Points{Eigen::Vector2d::Zero()}, hglasm::Pose2D()), 0u);
+}
+
+TEST(LookupTable, GradedValueIs255AtAReferencePoint) {
+  LookupTable table(gradedOptions());
+  const std::vector<Eigen::Vector2d> reference = {kCentre, {1.234, -5.678}, {-0.001, 0.001}, {0.0, 0.0}};
+  table.build(reference);
+  EXPECT_FALSE(table.empty());
+  EXPECT_EQ(table.maxCellValue(), 255u);
+  for (const auto& p : reference) EXPECT_EQ(table.valueAt(p), 255) << p.transpose();
+}
+
+TEST(LookupTable, GradedValueDecaysLikeTheNormalOfTheDistance) {
+  LookupTable table(gradedOptions());
+  table.build({kCentre});
+  int previous = 256;
+  for (int k = 0; k <= 15; ++k) {  // 0 .. 0.30 m along +x, -y and the diagonal (3, 4) * k / 5
+    const double d = k * kCell;
+    const int along_x = table.valueAt(kCentre + Eigen::Vector2d(d, 0.0));
+    const int along_minus_y = table.valueAt(kCentre + Eigen::Vector2d(0.0, -d));
+    EXPECT_NEAR(along_x, normal255(d), 1.0) << "d = " << d;
+    EXPECT_NEAR(along_minus_y, normal255(d), 1.0) << "d = " << d;
+    EXPECT_LE(along_x, previous) << "not monotonic at d = " << d;
+    previous = along_x;
+  }
+  // One sigma away on a diagonal: 255 * exp(-1/2) = 155.
+  EXPECT_NEAR(table.valueAt(kCentre + Eigen::Vector2d(3 * kCell, 4 * kCell)), normal255(kSigma), 1.0);
+  EXPECT_NEAR(table.valueAt(kCentre + Eigen::Vector2d(-6 * kCell, -8 * kCell)), normal255(2 * kSigma), 1.0);
+}
+
+TEST(LookupTable, GradedValueIsZeroBeyondTheCutoff) {
+  LookupTable table(gradedOptions());
+  table.build({kCentre});
+  EXPECT_GT(table.valueAt(kCentre + Eigen::Vector2d(kCutoff - kCell, 0.0)), 0);
+  EXPECT_EQ(table.valueAt(kCentre + Eigen::Vector2d(kCutoff + kCell, 0.0)), 0);
+  EXPECT_EQ(table.valueAt(kCentre + Eigen::Vector2d(0.0, -(kCutoff + 2 * kCell))), 0);
+  // The corner of the stamp's square is outside the cut-off circle.
+  EXPECT_EQ(table.valueAt(kCentre + Eigen::Vector2d(14 * kCell, 14 * kCell)), 0);
+  EXPECT_EQ(table.valueAt(kCentre + Eigen::Vector2d(5.0, 5.0)), 0);
+  EXPECT_EQ(table.valueAt(Eigen::Vector2d(-1e6, 1e6)), 0);
+  EXPECT_EQ(table.valueAt(Eigen::Vector2d(std::nan(""), 0.0)), 0);
+  EXPECT_EQ(table.valueAt(Eigen::Vector2d(std::numeric_limits<double>::infinity(), 0.0)), 0);
+}
+
+TEST(LookupTable, CellsHoldTheLikelihoodOfTheNearestPointNotASum) {
+  LookupTable table(gradedOptions());
+  const Eigen::Vector2d other = kCentre + Eigen::Vector2d(10 * kCell, 0.0);  // 0.2 m apart
+  table.build({kCentre, other});
+  EXPECT_EQ(table.valueAt(kCentre), 255);
+  EXPECT_EQ(table.valueAt(other), 255);
+  // Halfway: 0.1 m from both, one sigma: 155, not 2 * 155 (saturated) or a sum of tails.
+  EXPECT_NEAR(table.valueAt(kCentre + Eigen::Vector2d(5 * kCell, 0.0)), normal255(kSigma), 1.0);
+}
+
+TEST(LookupTable, SegmentsJoinCloseConsecutivePointsOnly) {
+  LookupTableOptions options = gradedOptions();
+  options.segment_max_gap = 0.30;
+  options.segment_gap_per_metre = 0.10;
+  LookupTable table(options);
+  // Beam order: a and b are 0.24 m apart (joined); b and c are 1.0 m apart at about 1 m range (not joined:
+  // the allowed gap there is 0.3 + 0.1 * 1 = 0.4 m).
+  const Eigen::Vector2d a = kCentre, b = kCentre + Eigen::Vector2d(12 * kCell, 0.0),
+                        c = b + Eigen::Vector2d(0.0, 50 * kCell);
+  table.build({a, b, c});
+  EXPECT_EQ(table.valueAt(a), 255);
+  EXPECT_EQ(table.valueAt(b), 255);
+  EXPECT_EQ(table.valueAt(c), 255);
+  for (int k = 1; k < 12; ++k) {  // on the surface between a and b: as good as a measured point
+    EXPECT_GE(table.valueAt(a + Eigen::Vector2d(k * kCell, 0.0)), 250) << k;
+  }
+  // Off the surface it decays with the distance to the segment.
+  EXPECT_NEAR(table.valueAt(a + Eigen::Vector2d(6 * kCell, 5 * kCell)), normal255(kSigma), 3.0);
+  // Halfway between b and c (0.5 m from both, no segment): nothing.
+  EXPECT_EQ(table.valueAt(b + Eigen::Vector2d(0.0, 25 * kCell)), 0);
+  // Only consecutive points are joined: in the order a, c, b, a and b are no longer neighbours.
+  LookupTable reordered(options);
+  reordered.build({a, c, b});
+  EXPECT_LT(reordered.valueAt(a + Eigen::Vector2d(6 * kCell, 0.0)), 250);
+}
+
+TEST(LookupTable, BinaryTableIsASquareOfOnes) {
+  LookupTable table(binaryOptions());
+  table.build({kCentre});
+  EXPECT_EQ(table.maxCellValue(), 1u);
+  EXPECT_EQ(table.valueAt(kCentre), 1);
+  const int half_side_cells = static_cast<int>(std::lround(kSigma / kCell));  // header: half-side sigma
+  // The corners of the square are inside (a square, not a disc) ...
+  for (int sx : {-1, 1}) {
+    for (int sy : {-1, 1}) {
+      EXPECT_EQ(table.valueAt(kCentre + kCell * Eigen::Vector2d(sx * half_side_cells, sy * half_side_cells)),
+                1);
+      EXPECT_EQ(table.valueAt(kCentre + kCell * Eigen::Vector2d(sx * (half_side_cells + 1), 0.0)), 0);
+      EXPECT_EQ(table.valueAt(kCentre + kCell * Eigen::Vector2d(0.0, sy * (half_side_cells + 1))), 0);
+    }
+  }
+  // ... and every cell inside holds exactly 1.
+  for (int dx = -half_side_cells; dx <= half_side_cells; ++dx) {
+    for (int dy = -half_side_cells; dy <= half_side_cells; ++dy) {
+      ASSERT_EQ(table.valueAt(kCentre + kCell * Eigen::Vector2d(dx, dy)), 1) << dx << " " << dy;
+    }
+  }
+}
+
+TEST(LookupTable, FitnessOfTheReferenceItselfIsTheMaximum) {
+  const auto world = hglasm_test::room();
+  const auto scan =
+      hglasm_test::simulateScan(world, hglasm::Pose2D(0.1, -0.2, 0.3), hglasm_test::halfCircleLaser());
+  ASSERT_GT(scan.size(), 300u);
+  LookupTable graded(gradedOptions());
+  graded.build(scan.points);
+  EXPECT_EQ(graded.fitness(scan.points, hglasm::Pose2D()), 255u * scan.size());
+  LookupTable binary(binaryOptions());
+  binary.build(scan.points);
+  EXPECT_EQ(binary.fitness(scan.points, hglasm::Pose2D()), scan.size());
+  // A displaced copy fits less.
+  EXPECT_LT(graded.fitness(scan.points, hglasm::Pose2D(0.05, 0.0, 0.0)), 255u * scan.size());
+  EXPECT_LT(graded.fitness(scan.points, hglasm::Pose2D(0.0, 0.0, 0.05)), 255u * scan.size());
+  // Far away nothing fits.
+  EXPECT_EQ(graded.fitness(scan.points, hglasm::Pose2D(100.0, 0.0, 0.0)), 0u);
+}
+
+TEST(LookupTable, FitnessIsTheSumOfCellValuesOfTheMovedPoints) {
+  const auto world = hglasm_test::room();
+  const auto reference = hglasm_test::simulateScan(world, hglasm::Pose2D(), hglasm_test::halfCircleLaser());
+  const auto other =
+      hglasm_test::simulateScan(world, hglasm::Pose2D(0.2, 0.1, 0.1), hglasm_test::halfCircleLaser());
+  LookupTable table(gradedOptions());
+  table.build(reference.points);
+  for (const hglasm::Pose2D& pose : {hglasm::Pose2D(), hglasm::Pose2D(0.2, 0.1, 0.1),
+                                     hglasm::Pose2D(0.21, 0.08, 0.12), hglasm::Pose2D(-1, 2, 3)}) {
+    std::uint64_t sum = 0;
+    for (const auto& p : hglasm_test::movePoints(other.points, pose)) sum += table.valueAt(p);
+    // Rounding of a moved point exactly onto a cell border may differ by one cell for a few points.
+    EXPECT_NEAR(static_cast<double>(table.fitness(other.points, pose)), static_cast<double>(sum),
+                0.01 * sum + 1.0);
+  }
+  // The true pose of the other scan fits far better than a wrong one.
+  EXPECT_GT(table.fitness(other.points, hglasm::Pose2D(0.2, 0.1, 0.1)),
+            2 * table.fitness(other.points, hglasm::Pose2D()));
+}
+
+TEST(LookupTable, PreparedPointsGiveTheSameFitness) {
+  const auto world = hglasm_test::room();
+  const auto reference = hglasm_test::simulateScan(world, hglasm::Pose2D(), hglasm_test::halfCircleLaser());
+  const auto other =
+      hglasm_test::simulateScan(world, hglasm::Pose2D(0.2, 0.1, 0.1), hglasm_test::halfCircleLaser());
+  LookupTable table(gradedOptions());
+  table.build(reference.points);
+  hglasm::FitnessPoints prepared;
+  prepared.assign(other.points);
+  ASSERT_EQ(prepared.size(), other.size());
+  for (const hglasm::Pose2D& pose :
+       {hglasm::Pose2D(), hglasm::Pose2D(0.2, 0.1, 0.1), hglasm::Pose2D(-1, 2, 3)}) {
+    const double exact = table.fitness(other.points, pose);
+    // Single precision may move a point on a cell border into the neighbouring cell.
+    EXPECT_NEAR(static_cast<double>(table.fitness(prepared, pose)), exact, 0.01 * exact + 1.0);
+  }
+  // The reference itself: every point on its own cell. (Walls at whole-cell coordinates, like y = -4 m
+  // seen from the origin, put points within rounding of a cell border; single precision may then pick the
+  // neighbouring cell, 250 instead of 255, for some of them: within 1 %.)
+  prepared.assign(reference.points);
+  EXPECT_GE(table.fitness(prepared, hglasm::Pose2D()), 0.99 * 255.0 * reference.size());
+  EXPECT_LE(table.fitness(prepared, hglasm::Pose2D()), 255u * reference.size());
+}
+
+TEST(LookupTable, NonFinitePointsAreIgnored) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  LookupTable table(gradedOptions());
+  table.build({kCentre, {nan, 0.0}, {0.0, inf}, {-inf, nan}});
+  EXPECT_EQ(table.valueAt(kCentre), 255);
+  EXPECT_LE(table.tileCount(), 4u);
+  EXPECT_EQ(table.fitness(Points{kCentre, {nan, nan}, {inf, 0.0}}, hglasm::Pose2D()), 255u);
+  EXPECT_EQ(table.fitness(Points{kCentre}, hglasm::Pose2D(nan, 0.0, 0.0)), 0u);
+  LookupTable only_bad(gradedOptions());
+  only_bad.build({{nan, nan}});
+  EXPECT_TRUE(only_bad.empty());
+}
+
+TEST(LookupTable, MemoryIsProportionalToTheCoveredArea) {
+  LookupTable short_line(gradedOptions());
+  short_line.build(linePoints(10.0, 0.05));
+  LookupTable long_line(gradedOptions());
+  long_line.build(linePoints(20.0, 0.05));
+  const double ratio =
+      static_cast<double>(long_line.tileCount()) / static_cast<double>(short_line.tileCount());
+  EXPECT_GT(ratio, 1.6);
+  EXPECT_LT(ratio, 2.4);
+  const double memory_ratio =
+      static_cast<double>(long_line.memoryBytes()) / static_cast<double>(short_line.memoryBytes());
+  EXPECT_LT(memory_ratio, 3.0);
+  // A diagonal wall 28 m long covers a strip, not the 20 m x 20 m bounding box of a dense grid.
+  std::vector<Eigen::Vector2d> diagonal;
+  for (double t = 0.0; t <= 20.0; t += 0.05) diagonal.emplace_back(t, t);
+  LookupTable diagonal_table(gradedOptions());
+  diagonal_table.build(diagonal);
+  const double dense_bytes = (20.0 / kCell) * (20.0 / kCell);
+  EXPECT_LT(static_cast<double>(diagonal_table.memoryBytes()), 0.25 * dense_bytes);
+}
+
+TEST(LookupTable, FarApartPointsDoNotAllocateTheSpaceBetween) {
+  LookupTable table(gradedOptions());
+  table.build({{0.0, 0.0}, {100.0, 100.0}});
+  EXPECT_LE(table.tileCount(), 8u);                              // at most 4 tiles around each point
+  const double dense_bytes = (100.0 / kCell) * (100.0 / kCell);  // 25 MB
+  EXPECT_LT(static_cast<double>(table.memoryBytes()), 0.01 * dense_bytes);
+  EXPECT_EQ(table.valueAt({100.0, 100.0}), 255);
+  EXPECT_EQ(table.valueAt({50.0, 50.0}), 0);
+}
+
+TEST(LookupTable, WildButFinitePointsDoNotExhaustMemory) {
+  LookupTable table(gradedOptions());
+  table.build({{0.0, 0.0}, {1e7, -1e7}, {3e38, 3e38}, {-1e300, 0.0}});
+  EXPECT_EQ(table.valueAt({0.0, 0.0}), 255);
+  EXPECT_LT(table.memoryBytes(), std::size_t{64} << 20);
+  EXPECT_EQ(table.fitness(Points{{1e300, -1e300}, {0.0, 0.0}}, hglasm::Pose2D()), 255u);
+}
+
+TEST(LookupTable, RebuildReplacesTheOldReference) {
+  LookupTable table(gradedOptions());
+  table.build({{0.0, 0.0}});
+  EXPECT_EQ(table.valueAt({0.0, 0.0}), 255);
+  table.build({{10.0, -3.0}});
+  EXPECT_EQ(table.valueAt({0.0, 0.0}), 0);
+  EXPECT_EQ(table.valueAt({10.0, -3.0}), 255);
+  table.build({});
+  EXPECT_TRUE(table.empty());
+  EXPECT_EQ(table.valueAt({10.0, -3.0}), 0);
+}
+
+TEST(LookupTable, OtherCellSizesAndSigmas) {
+  LookupTableOptions options = gradedOptions();
+  options.cell_size = 0.01;
+  options.sigma = 0.05;
+  options.cutoff = 0.15;
+  LookupTable table(options);
+  const Eigen::Vector2d centre(0.005, 0.005);
+  table.build({centre});
+  EXPECT_EQ(table.valueAt(centre), 255);
+  EXPECT_NEAR(table.valueAt(centre + Eigen::Vector2d(0.05, 0.0)), 255.0 * std::exp(-0.5), 1.0);
+  EXPECT_EQ(table.valueAt(centre + Eigen::Vector2d(0.17, 0.0)), 0);
+}
+
+}  // namespace

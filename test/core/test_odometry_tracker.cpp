@@ -1,0 +1,373 @@
+// Laser odometry on a simulated robot: known paths with and without wheel odometry, keyframe policy,
+// laser mounting, time going backwards or jumping, duplicate stamps, and empty scans.
+#include "hglasm_odometry/core/odometry_tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "test_util.h"
+
+namespace {
+
+using hglasm::OdometryTracker;
+using hglasm::Pose2D;
+using hglasm::PredictionSource;
+using hglasm::TrackerOptions;
+using hglasm::TrackerUpdate;
+
+using Path = std::function<Pose2D(double)>;
+
+/// Clockwise circle of radius 1.5 m through the origin at 0.5 m/s, starting at the identity pose; it stays
+/// clear of the room's boxes and walls.
+Pose2D circlePath(double t) {
+  const double radius = 1.5, rate = 0.5 / radius;
+  return hglasm_test::rawPose(radius * std::sin(rate * t), -radius + radius * std::cos(rate * t),
+                              hglasm_test::angleDiff(-rate * t, 0.0));
+}
+
+/// Straight along +x at `speed` m/s from the origin.
+Path straightPath(double speed) {
+  return [speed](double t) { return hglasm_test::rawPose(speed * t, 0.0, 0.0); };
+}
+
+/// Turning on the spot at `rate` rad/s.
+Path spinPath(double rate) {
+  return [rate](double t) { return hglasm_test::rawPose(0.0, 0.0, hglasm_test::angleDiff(rate * t, 0.0)); };
+}
+
+void expectSane(const TrackerUpdate& update) {
+  EXPECT_TRUE(update.pose.isFinite()) << "stamp " << update.stamp;
+  EXPECT_TRUE(update.guess.isFinite()) << "stamp " << update.stamp;
+  EXPECT_TRUE(update.velocity.allFinite()) << "stamp " << update.stamp;
+  EXPECT_TRUE(hglasm_test::isValidCovariance(update.pose_covariance)) << update.pose_covariance;
+  EXPECT_TRUE(hglasm_test::isValidCovariance(update.velocity_covariance)) << update.velocity_covariance;
+  EXPECT_TRUE(update.match.pose.isFinite());
+  EXPECT_TRUE(update.match.covariance.allFinite());
+}
+
+/// Drives a simulated robot along `path` and feeds the tracker its scans (and optionally wheel odometry).
+class SimulatedRobot {
+ public:
+  SimulatedRobot(const TrackerOptions& options, Path path)
+      : tracker_(options),
+        path_(std::move(path)),
+        world_(hglasm_test::room()),
+        laser_(hglasm_test::halfCircleLaser()) {}
+
+  void setMount(const Pose2D& mount) {
+    mount_ = mount;
+    tracker_.setLaserMount(mount);
+  }
+
+  /// Wheel odometry with a scale error and a heading drift (integrated from the true motion).
+  void enableOdometry(double scale_error, double drift_per_metre) {
+    odometry_ = true;
+    scale_error_ = scale_error;
+    drift_per_metre_ = drift_per_metre;
+  }
+
+  Pose2D truth(double t) const { return path_(t); }
+  Pose2D odometryPose() const { return odometry_pose_; }
+
+  /// Scan of the laser on the robot at time t.
+  hglasm::Scan scanAt(double t) const {
+    return hglasm_test::simulateScan(world_, hglasm_test::composeByHand(path_(t), mount_), laser_);
+  }
+
+  /// Advances to time t: wheel odometry at 50 Hz up to t, then one scan at t (or `scan` if given).
+  TrackerUpdate step(double t, const hglasm::Scan* scan = nullptr) {
+    if (odometry_) {
+      while (odometry_time_ + 0.02 <= t + 1e-9) {
+        const Pose2D previous = path_(odometry_time_);
+        odometry_time_ += 0.02;
+        const Pose2D motion = hglasm_test::relativeByHand(previous, path_(odometry_time_));
+        const double distance = std::hypot(motion.x, motion.y);
+        const Pose2D biased =
+            hglasm_test::rawPose((1.0 + scale_error_) * motion.x, (1.0 + scale_error_) * motion.y,
+                                 motion.theta + drift_per_metre_ * distance);
+        odometry_pose_ = hglasm_test::composeByHand(odometry_pose_, biased);
+        tracker_.addOdometry(odometry_time_, odometry_pose_);
+      }
+    }
+    return scan ? tracker_.processScan(t, *scan) : tracker_.processScan(t, scanAt(t));
+  }
+
+  OdometryTracker& tracker() { return tracker_; }
+
+ private:
+  OdometryTracker tracker_;
+  Path path_;
+  hglasm_test::World world_;
+  hglasm_test::LaserSpec laser_;
+  Pose2D mount_;
+  bool odometry_ = false;
+  double scale_error_ = 0.0;
+  double drift_per_metre_ = 0.0;
+  double odometry_time_ = 0.0;
+  Pose2D odometry_pose_;
+};
+
+TrackerOptions withoutOdometry() {
+  TrackerOptions options;
+  options.use_odometry = false;
+  return options;
+}
+
+TEST(OdometryTracker, FirstScanIsPublishedAtTheOrigin) {
+  SimulatedRobot robot(TrackerOptions(), circlePath);
+  const TrackerUpdate first = robot.step(0.0);
+  expectSane(first);
+  EXPECT_TRUE(first.published);
+  EXPECT_FALSE(first.matched);
+  EXPECT_TRUE(first.new_keyframe);
+  EXPECT_EQ(first.pose.x, 0.0);
+  EXPECT_EQ(first.pose.y, 0.0);
+  EXPECT_EQ(first.pose.theta, 0.0);
+}
+
+/// Drives `seconds` at 10 Hz; returns the final update. Every update must be sane and matched.
+TrackerUpdate drive(SimulatedRobot* robot, double seconds, int* fallbacks, int* keyframes) {
+  TrackerUpdate update;
+  *fallbacks = 0;
+  *keyframes = 0;
+  for (int i = 0; i <= static_cast<int>(std::lround(seconds * 10.0)); ++i) {
+    update = robot->step(0.1 * i);
+    expectSane(update);
+    EXPECT_TRUE(update.published);
+    if (i > 0) {
+      EXPECT_TRUE(update.matched) << "scan " << i;
+      if (update.fallback) ++*fallbacks;
+      if (update.new_keyframe) ++*keyframes;
+    }
+  }
+  return update;
+}
+
+TEST(OdometryTracker, FollowsACircleWithoutWheelOdometry) {
+  SimulatedRobot robot(withoutOdometry(), circlePath);
+  int fallbacks = 0, keyframes = 0;
+  const TrackerUpdate last = drive(&robot, 25.0, &fallbacks, &keyframes);  // 12.5 m, 5/6 of a turn
+  const Pose2D truth = robot.truth(25.0);
+  EXPECT_EQ(fallbacks, 0);
+  EXPECT_GT(keyframes, 10);
+  EXPECT_EQ(last.prediction, PredictionSource::kConstantVelocity);
+  EXPECT_LT(hglasm_test::translationError(last.pose, truth), 0.05)
+      << "final " << last.pose.x << " " << last.pose.y << " " << last.pose.theta << " vs " << truth.x << " "
+      << truth.y << " " << truth.theta;
+  EXPECT_LT(hglasm_test::rotationError(last.pose, truth), hglasm_test::deg(0.5));
+  // The velocity is the path's: 0.5 m/s forward, turning right at 1/3 rad/s.
+  EXPECT_NEAR(last.velocity.x(), 0.5, 0.05);
+  EXPECT_NEAR(last.velocity.y(), 0.0, 0.05);
+  EXPECT_NEAR(last.velocity.z(), -1.0 / 3.0, 0.05);
+}
+
+TEST(OdometryTracker, FollowsACircleWithDriftingWheelOdometry) {
+  SimulatedRobot robot(TrackerOptions(), circlePath);
+  robot.enableOdometry(0.05, 0.03);  // 5 % scale error, 0.03 rad of heading drift per metre
+  int fallbacks = 0, keyframes = 0;
+  const TrackerUpdate last = drive(&robot, 25.0, &fallbacks, &keyframes);
+  const Pose2D truth = robot.truth(25.0);
+  EXPECT_EQ(fallbacks, 0);
+  EXPECT_EQ(last.prediction, PredictionSource::kOdometry);
+  EXPECT_LT(hglasm_test::translationError(last.pose, truth), 0.05)
+      << "final " << last.pose.x << " " << last.pose.y << " " << last.pose.theta << " vs " << truth.x << " "
+      << truth.y << " " << truth.theta;
+  EXPECT_LT(hglasm_test::rotationError(last.pose, truth), hglasm_test::deg(0.5));
+  // The wheel odometry alone is far off: the laser did the work.
+  EXPECT_GT(hglasm_test::translationError(robot.odometryPose(), truth), 0.3);
+}
+
+TEST(OdometryTracker, LaserMountIsAccountedFor) {
+  SimulatedRobot robot(withoutOdometry(), circlePath);
+  robot.setMount(Pose2D(0.3, 0.1, 0.2));
+  int fallbacks = 0, keyframes = 0;
+  const TrackerUpdate last = drive(&robot, 10.0, &fallbacks, &keyframes);
+  const Pose2D truth = robot.truth(10.0);  // the base, not the laser
+  EXPECT_EQ(fallbacks, 0);
+  EXPECT_LT(hglasm_test::translationError(last.pose, truth), 0.03)
+      << "final " << last.pose.x << " " << last.pose.y << " " << last.pose.theta << " vs " << truth.x << " "
+      << truth.y << " " << truth.theta;
+  EXPECT_LT(hglasm_test::rotationError(last.pose, truth), hglasm_test::deg(0.5));
+}
+
+TEST(OdometryTracker, KeyframesFollowKeyframeDistance) {
+  TrackerOptions options = withoutOdometry();
+  options.keyframe_distance = 0.30;
+  options.keyframe_angle = 10.0;
+  SimulatedRobot robot(options, straightPath(0.4));  // 0.04 m per scan
+  int keyframes = 0;
+  for (int i = 1; i <= 40; ++i) {  // 1.6 m: a new keyframe past every 0.30 m, i.e. every 8 scans
+    const TrackerUpdate update = robot.step(0.1 * i);
+    if (i == 1) continue;
+    expectSane(update);
+    EXPECT_FALSE(update.fallback) << i;
+    if (update.new_keyframe) {
+      ++keyframes;
+      EXPECT_EQ(i % 8, 1) << "keyframe at scan " << i;  // moved 0.32 m since the last one
+    }
+  }
+  EXPECT_EQ(keyframes, 4);
+}
+
+TEST(OdometryTracker, KeyframesFollowKeyframeAngle) {
+  TrackerOptions options = withoutOdometry();
+  options.keyframe_distance = 100.0;
+  options.keyframe_angle = 0.20;
+  SimulatedRobot robot(options, spinPath(0.3));  // 0.03 rad per scan
+  int keyframes = 0;
+  const int first_keyframe = robot.step(0.0).keyframe_id;
+  for (int i = 1; i <= 42; ++i) {  // a new keyframe past every 0.2 rad, i.e. every 7 scans
+    const TrackerUpdate update = robot.step(0.1 * i);
+    expectSane(update);
+    EXPECT_FALSE(update.fallback) << i;
+    if (update.new_keyframe) {
+      ++keyframes;
+      EXPECT_EQ(i % 7, 0) << "keyframe at scan " << i;
+    }
+  }
+  EXPECT_EQ(keyframes, 6);
+  EXPECT_EQ(robot.tracker().keyframeId(), first_keyframe + 6);
+  EXPECT_NEAR(hglasm_test::angleDiff(robot.tracker().pose().theta, 0.3 * 4.2), 0.0, hglasm_test::deg(0.2));
+}
+
+TEST(OdometryTracker, TimeGoingBackwardsResets) {
+  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  for (int i = 0; i <= 10; ++i) robot.step(0.1 * i);
+  ASSERT_GT(robot.tracker().pose().x, 0.35);
+  const TrackerUpdate back = robot.step(0.5);  // a looped bag
+  expectSane(back);
+  EXPECT_TRUE(back.reset);
+  EXPECT_FALSE(back.warning.empty());
+  EXPECT_TRUE(back.published);
+  EXPECT_EQ(back.pose.x, 0.0);  // restarted from the origin
+  EXPECT_EQ(back.pose.theta, 0.0);
+  // And it carries on: the motion after the reset is tracked from the new origin, without more resets.
+  TrackerUpdate update;
+  for (int i = 6; i <= 15; ++i) {
+    update = robot.step(0.1 * i);
+    expectSane(update);
+    EXPECT_FALSE(update.reset) << i;
+    EXPECT_TRUE(update.matched) << i;
+    EXPECT_FALSE(update.fallback) << i;
+  }
+  EXPECT_NEAR(update.pose.x, 0.4 * (1.5 - 0.5), 0.01);
+  EXPECT_NEAR(update.pose.y, 0.0, 0.01);
+}
+
+TEST(OdometryTracker, TimeJumpingForwardResets) {
+  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
+  const TrackerUpdate jump = robot.step(0.5 + 600.0);
+  expectSane(jump);
+  EXPECT_TRUE(jump.reset);
+  EXPECT_FALSE(jump.warning.empty());
+  const TrackerUpdate next = robot.step(0.6 + 600.0);
+  expectSane(next);
+  EXPECT_FALSE(next.reset);
+}
+
+TEST(OdometryTracker, DuplicateStampsNeverGiveNaN) {
+  for (bool with_odometry : {false, true}) {
+    SCOPED_TRACE(with_odometry ? "with odometry" : "without odometry");
+    SimulatedRobot robot(with_odometry ? TrackerOptions() : withoutOdometry(), straightPath(0.4));
+    if (with_odometry) robot.enableOdometry(0.0, 0.0);
+    for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
+    const hglasm::Scan same = robot.scanAt(0.5);
+    const hglasm::Scan later = robot.scanAt(0.52);
+    const TrackerUpdate duplicate = robot.tracker().processScan(0.5, same);
+    expectSane(duplicate);
+    EXPECT_FALSE(duplicate.reset);
+    const TrackerUpdate moved_same_stamp = robot.tracker().processScan(0.5, later);
+    expectSane(moved_same_stamp);
+    const TrackerUpdate tiny_dt = robot.tracker().processScan(0.5 + 1e-7, later);
+    expectSane(tiny_dt);
+    // Carrying on is still fine.
+    TrackerUpdate update;
+    for (int i = 6; i <= 12; ++i) {
+      update = robot.step(0.1 * i);
+      expectSane(update);
+    }
+    EXPECT_NEAR(update.pose.x, 0.4 * 1.2, 0.02);
+    EXPECT_NEAR(update.velocity.x(), 0.4, 0.05);
+  }
+}
+
+TEST(OdometryTracker, EmptyScansFallBackToTheOdometryGuess) {
+  SimulatedRobot robot(TrackerOptions(), circlePath);
+  robot.enableOdometry(0.0, 0.0);  // exact wheel odometry: the fallback must follow it
+  for (int i = 0; i <= 20; ++i) robot.step(0.1 * i);
+  const hglasm::Scan empty;
+  for (int i = 21; i <= 25; ++i) {
+    const TrackerUpdate update = robot.step(0.1 * i, &empty);
+    expectSane(update);
+    EXPECT_TRUE(update.published) << i;
+    EXPECT_TRUE(update.fallback) << i;
+    EXPECT_EQ(update.prediction, PredictionSource::kOdometry);
+    const Pose2D truth = robot.truth(0.1 * i);
+    EXPECT_LT(hglasm_test::translationError(update.pose, truth), 0.01) << i;
+    EXPECT_LT(hglasm_test::rotationError(update.pose, truth), hglasm_test::deg(0.2)) << i;
+  }
+  // The uncertainty grew during the fallback, and tracking resumes with real scans.
+  TrackerUpdate update;
+  for (int i = 26; i <= 40; ++i) {
+    update = robot.step(0.1 * i);
+    expectSane(update);
+    EXPECT_FALSE(update.fallback) << i;
+  }
+  EXPECT_LT(hglasm_test::translationError(update.pose, robot.truth(4.0)), 0.02);
+}
+
+TEST(OdometryTracker, EmptyScansWithoutOdometryKeepTheConstantVelocity) {
+  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  for (int i = 0; i <= 10; ++i) robot.step(0.1 * i);
+  const TrackerUpdate before = robot.step(1.1);
+  const hglasm::Scan empty;
+  TrackerUpdate update;
+  for (int i = 12; i <= 14; ++i) {
+    update = robot.step(0.1 * i, &empty);
+    expectSane(update);
+    EXPECT_TRUE(update.fallback) << i;
+    EXPECT_EQ(update.prediction, PredictionSource::kConstantVelocity);
+  }
+  EXPECT_NEAR(update.pose.x, 0.4 * 1.4, 0.01);  // kept moving at 0.4 m/s
+  EXPECT_NEAR(update.pose.y, 0.0, 0.01);
+  EXPECT_GT(update.pose_covariance.trace(), before.pose_covariance.trace());
+}
+
+TEST(OdometryTracker, TooFewPointsAndNonFiniteScansAreFallbacks) {
+  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
+  hglasm::Scan few = robot.scanAt(0.6);
+  few.points.resize(5);
+  few.beam_index.resize(5);
+  TrackerUpdate update = robot.step(0.6, &few);
+  expectSane(update);
+  EXPECT_TRUE(update.fallback);
+  hglasm::Scan garbage = robot.scanAt(0.7);
+  for (auto& p : garbage.points) p = Eigen::Vector2d(std::numeric_limits<double>::quiet_NaN(), 1.0);
+  update = robot.step(0.7, &garbage);
+  expectSane(update);
+  EXPECT_TRUE(update.fallback);
+  update = robot.tracker().processScan(std::numeric_limits<double>::quiet_NaN(), robot.scanAt(0.8));
+  expectSane(update);
+  update = robot.step(0.8);
+  expectSane(update);
+  EXPECT_NEAR(update.pose.x, 0.32, 0.02);
+}
+
+TEST(OdometryTracker, ExplicitResetRestartsAtTheOrigin) {
+  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
+  robot.tracker().reset();
+  const TrackerUpdate update = robot.step(0.6);
+  expectSane(update);
+  EXPECT_TRUE(update.reset);
+  EXPECT_FALSE(update.matched);
+  EXPECT_EQ(update.pose.x, 0.0);
+  EXPECT_EQ(robot.tracker().pose().x, 0.0);
+}
+
+}  // namespace

@@ -1,0 +1,211 @@
+// The relations metric on synthetic trajectories with known answers, and the relations file reader.
+#include "hglasm_odometry/core/relations.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace hglasm {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+/// A winding ground-truth path: one pose per second, stamps starting at `t0`.
+std::vector<StampedPose> groundTruth(int count, double t0 = 1000.0) {
+  std::vector<StampedPose> poses;
+  Pose2D pose(1.0, -2.0, 0.3);
+  for (int i = 0; i < count; ++i) {
+    poses.push_back({t0 + i, pose});
+    pose = pose * Pose2D(0.4 + 0.05 * (i % 3), 0.02 * ((i % 5) - 2), 0.1 * std::sin(0.7 * i));
+  }
+  return poses;
+}
+
+/// Relations between poses i and i + step (exact ground truth).
+std::vector<Relation> relationsOf(const std::vector<StampedPose>& truth, int step) {
+  std::vector<Relation> relations;
+  for (std::size_t i = 0; i + step < truth.size(); ++i) {
+    relations.push_back(
+        {truth[i].stamp, truth[i + step].stamp, relativePose(truth[i].pose, truth[i + step].pose)});
+  }
+  return relations;
+}
+
+TEST(Relations, PerfectTrajectoryHasZeroError) {
+  const auto truth = groundTruth(30);
+  const auto relations = relationsOf(truth, 3);
+  // Express the estimate in another odometry frame: the metric only sees relative motions.
+  std::vector<StampedPose> estimate = truth;
+  for (auto& pose : estimate) pose.pose = Pose2D(5.0, 7.0, 2.0) * pose.pose;
+
+  const RelationStats stats = evaluateRelations(relations, estimate, 0.0);
+  EXPECT_EQ(stats.count, 27);
+  EXPECT_EQ(stats.missing, 0);
+  EXPECT_NEAR(stats.trans_mean, 0.0, 1e-9);
+  EXPECT_NEAR(stats.trans_std, 0.0, 1e-9);
+  EXPECT_NEAR(stats.rot_mean_deg, 0.0, 1e-7);
+  EXPECT_NEAR(stats.rot_std_deg, 0.0, 1e-7);
+  EXPECT_NEAR(stats.trans_sq_mean, 0.0, 1e-12);
+  EXPECT_NEAR(stats.rot_sq_mean_deg, 0.0, 1e-12);
+}
+
+TEST(Relations, ConstantBiasPerStepGivesThatBias) {
+  // Each estimated step is the true step followed by the same small extra motion, so every one-step
+  // relation's residual is exactly that extra motion.
+  const Pose2D bias(0.03, -0.04, 0.02);
+  const auto truth = groundTruth(40);
+  std::vector<StampedPose> estimate = {truth[0]};
+  for (std::size_t i = 1; i < truth.size(); ++i) {
+    const Pose2D true_step = relativePose(truth[i - 1].pose, truth[i].pose);
+    estimate.push_back({truth[i].stamp, estimate.back().pose * true_step * bias});
+  }
+  const RelationStats stats = evaluateRelations(relationsOf(truth, 1), estimate, 0.0);
+  EXPECT_EQ(stats.count, 39);
+  EXPECT_NEAR(stats.trans_mean, 0.05, 1e-9);
+  EXPECT_NEAR(stats.trans_std, 0.0, 1e-9);
+  EXPECT_NEAR(stats.trans_sq_mean, 0.0025, 1e-10);
+  EXPECT_NEAR(stats.rot_mean_deg, 0.02 * kRadToDeg, 1e-7);
+  EXPECT_NEAR(stats.rot_std_deg, 0.0, 1e-7);
+  EXPECT_NEAR(stats.rot_sq_mean_deg, std::pow(0.02 * kRadToDeg, 2), 1e-7);
+}
+
+TEST(Relations, MeanStdAndSquaresOfDifferentErrors) {
+  // Straight drive along x at 1 m/s estimated at 1.1 m/s: a relation over s seconds is off by 0.1 s.
+  std::vector<StampedPose> estimate;
+  for (int i = 0; i <= 10; ++i) estimate.push_back({static_cast<double>(i), Pose2D(1.1 * i, 0.0, 0.0)});
+  const std::vector<Relation> relations = {{0.0, 1.0, Pose2D(1.0, 0.0, 0.0)},
+                                           {2.0, 5.0, Pose2D(3.0, 0.0, 0.0)}};
+  const RelationStats stats = evaluateRelations(relations, estimate, 0.0);
+  EXPECT_EQ(stats.count, 2);
+  EXPECT_NEAR(stats.trans_mean, 0.2, 1e-12);
+  EXPECT_NEAR(stats.trans_std, 0.1, 1e-12);  // population standard deviation
+  EXPECT_NEAR(stats.trans_sq_mean, (0.01 + 0.09) / 2.0, 1e-12);
+  EXPECT_NEAR(stats.rot_mean_deg, 0.0, 1e-12);
+}
+
+TEST(Relations, RotationalErrorIsWrappedAndAbsolute) {
+  // Reference turn of pi - 0.01, estimate -pi + 0.01 (the same heading crossed the other way):
+  // a 0.02 rad error, not 2 pi - 0.02.
+  const std::vector<StampedPose> estimate = {{0.0, Pose2D()}, {1.0, Pose2D(0.0, 0.0, -M_PI + 0.01)}};
+  const std::vector<Relation> relations = {{0.0, 1.0, Pose2D(0.0, 0.0, M_PI - 0.01)}};
+  const RelationStats stats = evaluateRelations(relations, estimate, 0.0);
+  ASSERT_EQ(stats.count, 1);
+  EXPECT_NEAR(stats.rot_mean_deg, 0.02 * kRadToDeg, 1e-9);
+
+  // A negative residual counts by its magnitude.
+  const std::vector<Relation> turn_left = {{0.0, 1.0, Pose2D(0.0, 0.0, 0.5)}};
+  const std::vector<StampedPose> turned_less = {{0.0, Pose2D()}, {1.0, Pose2D(0.0, 0.0, 0.4)}};
+  EXPECT_NEAR(evaluateRelations(turn_left, turned_less, 0.0).rot_mean_deg, 0.1 * kRadToDeg, 1e-9);
+}
+
+TEST(Relations, TranslationErrorIsMeasuredInTheRobotFrame) {
+  // The estimate at t1 is rotated by 90 deg: the same relative motion is still exact, but the
+  // t2 pose moved 0.2 m sideways in the world shows up as 0.2 m of error whatever the heading.
+  const std::vector<StampedPose> estimate = {{0.0, Pose2D(3.0, 4.0, M_PI / 2)},
+                                             {1.0, Pose2D(3.2, 5.0, M_PI / 2)}};
+  const std::vector<Relation> relations = {{0.0, 1.0, Pose2D(1.0, 0.0, 0.0)}};
+  const RelationStats stats = evaluateRelations(relations, estimate, 0.0);
+  ASSERT_EQ(stats.count, 1);
+  EXPECT_NEAR(stats.trans_mean, 0.2, 1e-12);
+  EXPECT_NEAR(stats.rot_mean_deg, 0.0, 1e-12);
+}
+
+TEST(Relations, MissingStampsAreCountedNotEvaluated) {
+  const auto truth = groundTruth(10);
+  std::vector<Relation> relations = relationsOf(truth, 2);  // 8 relations
+  relations[0].t1 += 0.01;                                  // beyond the default 1 ms tolerance: missing
+  relations[1].t2 += 5e-6;                                  // within tolerance: still matched
+  relations[2].t1 = 500.0;                                  // before the trajectory
+  relations[3].t2 = 2000.0;                                 // after the trajectory
+  const RelationStats stats = evaluateRelations(relations, truth, 0.0);
+  EXPECT_EQ(stats.missing, 3);
+  EXPECT_EQ(stats.count, 5);
+  EXPECT_NEAR(stats.trans_mean, 0.0, 1e-9);
+
+  // A looser tolerance finds the shifted stamp again.
+  EXPECT_EQ(evaluateRelations(relations, truth, 0.0, 0.015).missing, 2);
+
+  // An empty trajectory: everything missing, statistics stay zero.
+  const RelationStats empty = evaluateRelations(relations, {}, 0.0);
+  EXPECT_EQ(empty.count, 0);
+  EXPECT_EQ(empty.missing, 8);
+  EXPECT_EQ(empty.trans_mean, 0.0);
+}
+
+TEST(Relations, SpanFilterKeepsShortRelationsOnly) {
+  std::vector<StampedPose> estimate;
+  for (int i = 0; i <= 30; ++i) estimate.push_back({static_cast<double>(i), Pose2D(1.1 * i, 0.0, 0.0)});
+  const std::vector<Relation> relations = {
+      {0.0, 2.0, Pose2D(2.0, 0.0, 0.0)},     // span 2, error 0.2
+      {10.0, 20.0, Pose2D(10.0, 0.0, 0.0)},  // span exactly 10: kept by <= 10, error 1.0
+      {0.0, 30.0, Pose2D(30.0, 0.0, 0.0)},   // span 30, error 3.0
+      {25.0, 5.0, Pose2D(-20.0, 0.0, 0.0)},  // backwards, span 20, error 2.0
+  };
+  const RelationStats short_ones = evaluateRelations(relations, estimate, 10.0);
+  EXPECT_EQ(short_ones.count, 2);
+  EXPECT_EQ(short_ones.missing, 0);
+  EXPECT_NEAR(short_ones.trans_mean, 0.6, 1e-9);
+
+  const RelationStats all = evaluateRelations(relations, estimate, 0.0);
+  EXPECT_EQ(all.count, 4);
+  EXPECT_NEAR(all.trans_mean, (0.2 + 1.0 + 3.0 + 2.0) / 4.0, 1e-9);
+
+  // Filtered-out relations are not counted as missing even when their stamps are absent.
+  const std::vector<Relation> long_absent = {{0.0, 100.0, Pose2D()}};
+  EXPECT_EQ(evaluateRelations(long_absent, estimate, 10.0).missing, 0);
+  EXPECT_EQ(evaluateRelations(long_absent, estimate, 0.0).missing, 1);
+}
+
+TEST(Relations, ReadsRelationsFile) {
+  const std::string path = testing::TempDir() + "hglasm_test_relations.txt";
+  {
+    std::ofstream file(path);
+    file << "# comment\n"
+         << "1216.630413 1217.490267 0.407950 -0.016330 0.000000 0.000000 0.000000 -0.069620\n"
+         << "\n"
+         << "976052905.167303 976052911.885496 -0.05699 -0.12843 0.5 0.1 0.2 -1.68221\r\n";
+  }
+  std::vector<Relation> relations;
+  std::string error;
+  ASSERT_TRUE(readRelations(path, &relations, &error)) << error;
+  ASSERT_EQ(relations.size(), 2u);
+  EXPECT_DOUBLE_EQ(relations[0].t1, 1216.630413);
+  EXPECT_DOUBLE_EQ(relations[0].t2, 1217.490267);
+  EXPECT_DOUBLE_EQ(relations[0].motion.x, 0.407950);
+  EXPECT_DOUBLE_EQ(relations[0].motion.y, -0.016330);
+  EXPECT_DOUBLE_EQ(relations[0].motion.theta, -0.069620);
+  EXPECT_NEAR(relations[1].t2 - relations[1].t1, 6.718193, 1e-6);  // stamps keep microseconds
+  EXPECT_DOUBLE_EQ(relations[1].motion.theta, -1.68221);           // yaw, not roll or pitch
+
+  {
+    std::ofstream file(path);
+    file << "1.0 2.0 0.1 0.2 0 0 0 0.3\n1.0 2.0 0.1\n";
+  }
+  EXPECT_FALSE(readRelations(path, &relations, &error));
+  EXPECT_NE(error.find(":2:"), std::string::npos) << error;
+  std::remove(path.c_str());
+
+  EXPECT_FALSE(readRelations(path + ".does_not_exist", &relations, &error));
+  EXPECT_FALSE(error.empty());
+}
+
+TEST(Relations, ReadsTheBenchmarkFiles) {
+  const std::string root = HGLASM_SOURCE_DIR "/../shared/datasets/";
+  std::vector<Relation> relations;
+  std::string error;
+  if (!readRelations(root + "fr079/fr079.relations", &relations, &error)) {
+    GTEST_SKIP() << "dataset not available: " << error;
+  }
+  EXPECT_EQ(relations.size(), 1685u);
+  for (const Relation& relation : relations) {
+    ASSERT_TRUE(relation.motion.isFinite());
+    ASSERT_NE(relation.t1, relation.t2);
+  }
+}
+
+}  // namespace
+}  // namespace hglasm

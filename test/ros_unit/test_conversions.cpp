@@ -1,0 +1,307 @@
+// Message conversions: REP-117 ranges, descending and 360-degree scans, upside-down mounts, covariance.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include <tf2/LinearMath/Quaternion.h>
+
+#include "hglasm_odometry/core/scan.h"
+#include "hglasm_odometry/ros/conversions.h"
+
+namespace hglasm_odometry {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+sensor_msgs::LaserScan makeScan(int beams, double angle_min, double increment, float range) {
+  sensor_msgs::LaserScan msg;
+  msg.angle_min = angle_min;
+  msg.angle_increment = increment;
+  msg.angle_max = angle_min + increment * (beams - 1);
+  msg.range_min = 0.1f;
+  msg.range_max = 30.0f;
+  msg.ranges.assign(beams, range);
+  return msg;
+}
+
+geometry_msgs::Transform makeTransform(double x, double y, double z, double roll, double pitch, double yaw) {
+  tf2::Quaternion q;
+  q.setRPY(roll, pitch, yaw);
+  geometry_msgs::Transform t;
+  t.translation.x = x;
+  t.translation.y = y;
+  t.translation.z = z;
+  t.rotation.x = q.x();
+  t.rotation.y = q.y();
+  t.rotation.z = q.z();
+  t.rotation.w = q.w();
+  return t;
+}
+
+/// Maps a laser point (in the laser's own frame) into the base frame with the full 3D transform.
+Eigen::Vector2d projectWith3D(const geometry_msgs::Transform& t, const Eigen::Vector2d& p) {
+  tf2::Quaternion q(t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w);
+  const tf2::Vector3 v = tf2::quatRotate(q, tf2::Vector3(p.x(), p.y(), 0.0)) +
+                         tf2::Vector3(t.translation.x, t.translation.y, t.translation.z);
+  return Eigen::Vector2d(v.x(), v.y());
+}
+
+TEST(RangeScanFromMsg, CopiesPolarFieldsAndKeepsInvalidRangesForTheCore) {
+  sensor_msgs::LaserScan msg = makeScan(6, -0.5, 0.2, 2.0f);
+  msg.ranges = {2.0f,
+                std::numeric_limits<float>::quiet_NaN(),
+                std::numeric_limits<float>::infinity(),
+                -std::numeric_limits<float>::infinity(),
+                0.0f,
+                50.0f};
+  const hglasm::RangeScan scan = rangeScanFromMsg(msg);
+  ASSERT_EQ(scan.ranges.size(), 6u);
+  EXPECT_FLOAT_EQ(scan.angle_min, -0.5);
+  EXPECT_NEAR(scan.angle_increment, 0.2, 1e-7);
+  EXPECT_NEAR(scan.range_min, 0.1, 1e-7);
+  EXPECT_NEAR(scan.range_max, 30.0, 1e-6);
+
+  // Only the first beam is valid per REP-117 (NaN, +-inf, 0 and > range_max are not).
+  hglasm::ScanError error = hglasm::ScanError::kBadAngles;
+  const hglasm::Scan points = hglasm::scanFromRanges(scan, {}, &error);
+  EXPECT_EQ(error, hglasm::ScanError::kNone);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_EQ(points.invalid_count, 5);
+  EXPECT_NEAR(points.points[0].x(), 2.0 * std::cos(-0.5), 1e-6);
+  EXPECT_NEAR(points.points[0].y(), 2.0 * std::sin(-0.5), 1e-6);
+}
+
+TEST(RangeScanFromMsg, NonFiniteRangeLimitsDoNotInvalidateEveryBeam) {
+  sensor_msgs::LaserScan msg = makeScan(3, 0.0, 0.1, 5.0f);
+  msg.range_min = std::numeric_limits<float>::quiet_NaN();
+  msg.range_max = std::numeric_limits<float>::quiet_NaN();
+  hglasm::RangeScan scan = rangeScanFromMsg(msg);
+  EXPECT_EQ(scan.range_min, 0.0);
+  EXPECT_TRUE(std::isinf(scan.range_max));
+  EXPECT_EQ(hglasm::scanFromRanges(scan).size(), 3u);
+
+  msg.range_min = -1.0f;
+  msg.range_max = 0.0f;  // some drivers leave it unset
+  scan = rangeScanFromMsg(msg);
+  EXPECT_EQ(scan.range_min, 0.0);
+  EXPECT_TRUE(std::isinf(scan.range_max));
+}
+
+TEST(RangeScanFromMsg, DescendingAnglesGiveTheSamePointsAsAscendingOnes) {
+  // The same physical scan, stored from left to right and from right to left.
+  const int beams = 181;
+  sensor_msgs::LaserScan ascending = makeScan(beams, -M_PI / 2, M_PI / 180, 0.0f);
+  for (int i = 0; i < beams; ++i) ascending.ranges[i] = 1.0f + 0.01f * i;
+  sensor_msgs::LaserScan descending = makeScan(beams, M_PI / 2, -M_PI / 180, 0.0f);
+  for (int i = 0; i < beams; ++i) descending.ranges[i] = ascending.ranges[beams - 1 - i];
+
+  const hglasm::Scan a = hglasm::scanFromRanges(rangeScanFromMsg(ascending));
+  const hglasm::Scan d = hglasm::scanFromRanges(rangeScanFromMsg(descending));
+  ASSERT_EQ(a.size(), static_cast<std::size_t>(beams));
+  ASSERT_EQ(d.size(), static_cast<std::size_t>(beams));
+  for (int i = 0; i < beams; ++i) {
+    EXPECT_NEAR(a.points[i].x(), d.points[beams - 1 - i].x(), 1e-5);
+    EXPECT_NEAR(a.points[i].y(), d.points[beams - 1 - i].y(), 1e-5);
+  }
+  // Beam 0 of the descending scan is on the left (+y).
+  EXPECT_GT(d.points.front().y(), 0.9);
+}
+
+TEST(RangeScanFromMsg, FullCircleScanAcrossPlusMinusPi) {
+  // 360 beams starting just below +pi and wrapping through -pi: every direction exactly once.
+  const int beams = 360;
+  sensor_msgs::LaserScan msg = makeScan(beams, M_PI - 0.5 * M_PI / 180, 2 * M_PI / beams, 3.0f);
+  const hglasm::Scan scan = hglasm::scanFromRanges(rangeScanFromMsg(msg));
+  ASSERT_EQ(scan.size(), static_cast<std::size_t>(beams));
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (const auto& p : scan.points) {
+    EXPECT_NEAR(p.norm(), 3.0, 1e-5);
+    sum += p;
+  }
+  EXPECT_LT(sum.norm(), 1e-3);  // evenly spread around the circle
+}
+
+TEST(LaserMount, UprightMountIsTheYawAndTranslation) {
+  LaserMount mount;
+  std::string error;
+  ASSERT_TRUE(laserMountFromTransform(makeTransform(0.3, -0.1, 0.2, 0.0, 0.0, 0.7), &mount, &error)) << error;
+  EXPECT_FALSE(mount.upside_down);
+  EXPECT_NEAR(mount.base_to_laser.x, 0.3, 1e-12);
+  EXPECT_NEAR(mount.base_to_laser.y, -0.1, 1e-12);
+  EXPECT_NEAR(mount.base_to_laser.theta, 0.7, 1e-12);
+  EXPECT_NEAR(mount.tilt, 0.0, 1e-9);
+}
+
+TEST(LaserMount, UpsideDownMountMirrorsScansAndMatchesThe3DProjection) {
+  // Rolled over (180 degrees about x) and yawed: the 2D projection is a reflection.
+  for (double yaw : {0.0, 0.6, -2.5, M_PI}) {
+    const geometry_msgs::Transform t = makeTransform(0.25, 0.05, 0.4, M_PI, 0.0, yaw);
+    LaserMount mount;
+    std::string error;
+    ASSERT_TRUE(laserMountFromTransform(t, &mount, &error)) << error;
+    EXPECT_TRUE(mount.upside_down);
+    EXPECT_NEAR(mount.tilt, 0.0, 1e-6);
+
+    sensor_msgs::LaserScan msg = makeScan(91, -M_PI / 4, M_PI / 180, 0.0f);
+    for (int i = 0; i < 91; ++i) msg.ranges[i] = 1.0f + 0.02f * i;
+    hglasm::ScanConversionOptions mirrored;
+    mirrored.mirror = mount.upside_down;
+    const hglasm::Scan plain = hglasm::scanFromRanges(rangeScanFromMsg(msg));
+    const hglasm::Scan flipped = hglasm::scanFromRanges(rangeScanFromMsg(msg), mirrored);
+    ASSERT_EQ(plain.size(), flipped.size());
+    for (std::size_t i = 0; i < plain.size(); ++i) {
+      const Eigen::Vector2d expected = projectWith3D(t, plain.points[i]);
+      const Eigen::Vector2d actual = mount.base_to_laser * flipped.points[i];
+      EXPECT_NEAR((expected - actual).norm(), 0.0, 1e-9) << "yaw " << yaw << " beam " << i;
+    }
+  }
+}
+
+TEST(LaserMount, PitchedUpsideDownMountIsAlsoAReflection) {
+  // Upside down by pitching 180 degrees (about y) instead of rolling.
+  const geometry_msgs::Transform t = makeTransform(0.0, 0.0, 0.3, 0.0, M_PI, 0.3);
+  LaserMount mount;
+  std::string error;
+  ASSERT_TRUE(laserMountFromTransform(t, &mount, &error));
+  EXPECT_TRUE(mount.upside_down);
+  hglasm::ScanConversionOptions mirrored;
+  mirrored.mirror = true;
+  const Eigen::Vector2d p(1.0, 0.5);
+  const Eigen::Vector2d mirrored_p(p.x(), -p.y());
+  EXPECT_NEAR((projectWith3D(t, p) - mount.base_to_laser * mirrored_p).norm(), 0.0, 1e-9);
+}
+
+TEST(LaserMount, RejectsNonFiniteAndVerticalScanPlanes) {
+  LaserMount mount;
+  std::string error;
+  geometry_msgs::Transform t = makeTransform(0, 0, 0, 0, 0, 0);
+  t.translation.x = kNaN;
+  EXPECT_FALSE(laserMountFromTransform(t, &mount, &error));
+  EXPECT_FALSE(error.empty());
+  t = makeTransform(0, 0, 0, 0, 0, 0);
+  t.rotation.w = kInf;
+  EXPECT_FALSE(laserMountFromTransform(t, &mount, &error));
+  t.rotation.x = t.rotation.y = t.rotation.z = t.rotation.w = 0.0;
+  EXPECT_FALSE(laserMountFromTransform(t, &mount, &error));
+  // Scan plane vertical (rolled 90 degrees): rejected, or accepted with its tilt reported.
+  error.clear();
+  EXPECT_FALSE(laserMountFromTransform(makeTransform(0, 0, 0, M_PI / 2, 0.0, 0.0), &mount, &error) &&
+               mount.tilt < 1.0)
+      << "a vertical scan plane must be rejected or reported as tilted";
+}
+
+TEST(PoseConversions, RoundTripsAndNeverEmitNaN) {
+  const hglasm::Pose2D pose(1.5, -2.0, 2.9);
+  hglasm::Pose2D back;
+  ASSERT_TRUE(pose2DFromPoseMsg(poseMsgFromPose2D(pose), &back));
+  EXPECT_NEAR(back.x, 1.5, 1e-12);
+  EXPECT_NEAR(back.y, -2.0, 1e-12);
+  EXPECT_NEAR(back.theta, 2.9, 1e-12);
+  ASSERT_TRUE(pose2DFromPose2DMsg(pose2DMsgFromPose2D(pose), &back));
+  EXPECT_NEAR(back.theta, 2.9, 1e-12);
+
+  hglasm::Pose2D bad;
+  bad.x = kNaN;
+  bad.theta = kInf;
+  const geometry_msgs::Pose msg = poseMsgFromPose2D(bad);
+  EXPECT_TRUE(std::isfinite(msg.position.x));
+  EXPECT_TRUE(std::isfinite(msg.orientation.z) && std::isfinite(msg.orientation.w));
+  EXPECT_NEAR(msg.orientation.w, 1.0, 1e-12);
+  const geometry_msgs::Pose2D msg2 = pose2DMsgFromPose2D(bad);
+  EXPECT_TRUE(std::isfinite(msg2.x) && std::isfinite(msg2.theta));
+  const geometry_msgs::Transform tf = transformMsgFromPose2D(bad);
+  EXPECT_TRUE(std::isfinite(tf.translation.x) && std::isfinite(tf.rotation.w));
+
+  geometry_msgs::Pose nan_pose;
+  nan_pose.orientation.w = 1.0;
+  nan_pose.position.y = kNaN;
+  back = pose;
+  EXPECT_FALSE(pose2DFromPoseMsg(nan_pose, &back));
+  EXPECT_EQ(back.x, pose.x);  // untouched
+  geometry_msgs::Pose2D nan_pose2d;
+  nan_pose2d.theta = kNaN;
+  EXPECT_FALSE(pose2DFromPose2DMsg(nan_pose2d, &back));
+}
+
+TEST(PoseConversions, YawOfUnnormalisedAndDegenerateQuaternions) {
+  geometry_msgs::Quaternion q = quaternionFromYaw(-1.2);
+  q.x *= 3.0;
+  q.y *= 3.0;
+  q.z *= 3.0;
+  q.w *= 3.0;
+  EXPECT_NEAR(yawFromQuaternion(q), -1.2, 1e-12);
+  geometry_msgs::Quaternion zero;
+  zero.w = 0.0;
+  EXPECT_EQ(yawFromQuaternion(zero), 0.0);
+  geometry_msgs::Quaternion nan_q;
+  nan_q.w = kNaN;
+  EXPECT_EQ(yawFromQuaternion(nan_q), 0.0);
+  EXPECT_NEAR(quaternionFromYaw(kNaN).w, 1.0, 1e-12);
+}
+
+TEST(PoseConversions, OdometryMessageGivesThePlanarPose) {
+  nav_msgs::Odometry odom;
+  odom.pose.pose.position.x = 3.0;
+  odom.pose.pose.position.y = 4.0;
+  odom.pose.pose.orientation = quaternionFromYaw(0.5);
+  hglasm::Pose2D pose;
+  ASSERT_TRUE(pose2DFromOdometryMsg(odom, &pose));
+  EXPECT_NEAR(pose.x, 3.0, 1e-12);
+  EXPECT_NEAR(pose.theta, 0.5, 1e-12);
+  odom.pose.pose.orientation.z = kInf;
+  EXPECT_FALSE(pose2DFromOdometryMsg(odom, &pose));
+}
+
+TEST(Covariance, PlanarBlockLandsOnXYYawAndUnobservedDimensionsAreLargeButFinite) {
+  Eigen::Matrix3d cov;
+  cov << 0.04, 0.01, 0.002,  //
+      0.01, 0.09, -0.003,    //
+      0.002, -0.003, 0.0025;
+  const boost::array<double, 36> out = covariance6x6FromPlanar(cov);
+  EXPECT_DOUBLE_EQ(out[0 * 6 + 0], 0.04);
+  EXPECT_DOUBLE_EQ(out[0 * 6 + 1], 0.01);
+  EXPECT_DOUBLE_EQ(out[1 * 6 + 0], 0.01);
+  EXPECT_DOUBLE_EQ(out[1 * 6 + 1], 0.09);
+  EXPECT_DOUBLE_EQ(out[0 * 6 + 5], 0.002);
+  EXPECT_DOUBLE_EQ(out[5 * 6 + 1], -0.003);
+  EXPECT_DOUBLE_EQ(out[5 * 6 + 5], 0.0025);
+  for (int i : {2, 3, 4}) {
+    EXPECT_DOUBLE_EQ(out[i * 6 + i], kUnobservedVariance);
+    for (int j = 0; j < 6; ++j) {
+      if (j != i) {
+        EXPECT_EQ(out[i * 6 + j], 0.0);
+      }
+    }
+  }
+}
+
+TEST(Covariance, NonFiniteEntriesAreReplacedAndTheResultIsSymmetric) {
+  Eigen::Matrix3d cov;
+  cov << kNaN, 0.01, kInf,  //
+      0.02, 0.09, 0.0,      //
+      -kInf, 0.0, kNaN;
+  const boost::array<double, 36> out = covariance6x6FromPlanar(cov);
+  for (double v : out) EXPECT_TRUE(std::isfinite(v));
+  EXPECT_DOUBLE_EQ(out[0], kUnobservedVariance);
+  EXPECT_DOUBLE_EQ(out[5 * 6 + 5], kUnobservedVariance);
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) EXPECT_DOUBLE_EQ(out[r * 6 + c], out[c * 6 + r]);
+  }
+  EXPECT_DOUBLE_EQ(out[0 * 6 + 1], 0.015);  // symmetrised
+  // A bad unobserved variance falls back to the default instead of producing NaN.
+  const boost::array<double, 36> fallback = covariance6x6FromPlanar(Eigen::Matrix3d::Identity(), kNaN);
+  EXPECT_DOUBLE_EQ(fallback[2 * 6 + 2], kUnobservedVariance);
+}
+
+TEST(FrameIds, LeadingSlashesAreStripped) {
+  EXPECT_EQ(stripLeadingSlash("/laser"), "laser");
+  EXPECT_EQ(stripLeadingSlash("//base_link"), "base_link");
+  EXPECT_EQ(stripLeadingSlash("odom"), "odom");
+  EXPECT_EQ(stripLeadingSlash("/"), "");
+  EXPECT_EQ(stripLeadingSlash(""), "");
+}
+
+}  // namespace
+}  // namespace hglasm_odometry

@@ -1,0 +1,229 @@
+// Parameter loading and validation from XmlRpc values (as the parameter server returns them): no master.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "hglasm_odometry/core/scan_matcher.h"
+#include "hglasm_odometry/ros/parameters.h"
+
+namespace hglasm_odometry {
+namespace {
+
+using XmlRpc::XmlRpcValue;
+
+/// Sets root["a"]["b"]... = value for a path "a/b".
+void set(XmlRpcValue& root, const std::string& path, const XmlRpcValue& value) {
+  XmlRpcValue* node = &root;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t slash = path.find('/', start);
+    const std::string key =
+        path.substr(start, slash == std::string::npos ? std::string::npos : slash - start);
+    if (slash == std::string::npos) {
+      (*node)[key] = value;
+      return;
+    }
+    node = &(*node)[key];
+    start = slash + 1;
+  }
+}
+
+XmlRpcValue params(std::initializer_list<std::pair<std::string, XmlRpcValue>> entries) {
+  XmlRpcValue root;
+  for (const auto& entry : entries) set(root, entry.first, entry.second);
+  return root;
+}
+
+/// Loads and expects failure; returns the error.
+std::string loadError(const XmlRpcValue& root) {
+  LaserOdometryOptions options;
+  std::string error;
+  EXPECT_FALSE(loadOptions(root, &options, &error));
+  EXPECT_FALSE(error.empty());
+  EXPECT_EQ(error.find('\n'), std::string::npos) << "one line: " << error;
+  return error;
+}
+
+TEST(Parameters, NoParametersGiveTheMediumPresetAndDefaults) {
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(XmlRpcValue(), &options, &error)) << error;
+  EXPECT_EQ(options.preset, "medium");
+  const hglasm::MatcherOptions medium = hglasm::presetOptions(hglasm::Preset::kMedium);
+  EXPECT_EQ(options.tracker.matcher.genetic.population, medium.genetic.population);
+  EXPECT_EQ(options.tracker.matcher.genetic.box.half_theta, medium.genetic.box.half_theta);
+  EXPECT_EQ(options.odom_frame, "odom");
+  EXPECT_EQ(options.base_frame, "base_link");
+  EXPECT_TRUE(options.publish_tf);
+  EXPECT_TRUE(options.use_odom);
+  EXPECT_TRUE(options.tracker.use_odometry);
+  EXPECT_FALSE(options.publish_population);
+  EXPECT_GE(options.queue_size, 1);
+}
+
+TEST(Parameters, BuiltInPresetsSelectTheirSearchSpace) {
+  for (const char* name : {"small", "medium", "large"}) {
+    LaserOdometryOptions options;
+    std::string error;
+    ASSERT_TRUE(loadOptions(params({{"preset", name}}), &options, &error)) << error;
+    hglasm::Preset preset;
+    ASSERT_TRUE(hglasm::parsePreset(name, &preset));
+    const hglasm::MatcherOptions expected = hglasm::presetOptions(preset);
+    EXPECT_EQ(options.preset, name);
+    EXPECT_EQ(options.tracker.matcher.genetic.population, expected.genetic.population) << name;
+    EXPECT_EQ(options.tracker.matcher.genetic.generations, expected.genetic.generations) << name;
+    EXPECT_EQ(options.tracker.matcher.genetic.runs, expected.genetic.runs) << name;
+    EXPECT_DOUBLE_EQ(options.tracker.matcher.genetic.box.half_x, expected.genetic.box.half_x) << name;
+  }
+}
+
+TEST(Parameters, PresetsYamlThenTopLevelOverridesWin) {
+  XmlRpcValue root = params({{"preset", "small"},
+                             {"presets/small/genetic/population", 33},
+                             {"presets/small/genetic/box_x", 0.4},
+                             {"presets/large/genetic/population", 999},
+                             {"genetic/box_x", 0.5},
+                             {"keyframe/distance", 0.7},
+                             {"odom_frame", "/laser_odom"},
+                             {"use_odom", false}});
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(root, &options, &error)) << error;
+  EXPECT_EQ(options.tracker.matcher.genetic.population, 33);          // from ~presets/small
+  EXPECT_DOUBLE_EQ(options.tracker.matcher.genetic.box.half_x, 0.5);  // top level beats the preset
+  EXPECT_DOUBLE_EQ(options.tracker.keyframe_distance, 0.7);
+  EXPECT_EQ(options.odom_frame, "laser_odom");  // leading slash stripped
+  EXPECT_FALSE(options.use_odom);
+  EXPECT_FALSE(options.tracker.use_odometry);
+}
+
+TEST(Parameters, IntegersAreAcceptedWhereNumbersAreExpected) {
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(params({{"genetic/box_theta", 1}, {"scan/max_range", 20}}), &options, &error))
+      << error;
+  EXPECT_DOUBLE_EQ(options.tracker.matcher.genetic.box.half_theta, 1.0);
+  EXPECT_DOUBLE_EQ(options.tracker.conversion.max_range, 20.0);
+}
+
+TEST(Parameters, CustomPresetDefinedUnderPresetsIsAccepted) {
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(params({{"preset", "corridor"}, {"presets/corridor/genetic/box_x", 1.5}}), &options,
+                          &error))
+      << error;
+  EXPECT_EQ(options.preset, "corridor");
+  EXPECT_DOUBLE_EQ(options.tracker.matcher.genetic.box.half_x, 1.5);
+}
+
+TEST(Parameters, UnknownPresetNamesTheParameter) {
+  const std::string error = loadError(params({{"preset", "huge"}}));
+  EXPECT_NE(error.find("~preset"), std::string::npos) << error;
+  EXPECT_NE(error.find("huge"), std::string::npos) << error;
+  EXPECT_NE(error.find("small"), std::string::npos) << error;
+}
+
+TEST(Parameters, NegativeAndZeroSizesNameTheParameter) {
+  EXPECT_EQ(loadError(params({{"genetic/population", -5}})),
+            "parameter ~genetic/population must be an integer in [2, 100000], got -5");
+  EXPECT_NE(loadError(params({{"genetic/generations", 0}}))
+                .find("~genetic/generations must be a positive integer, got 0"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"queue_size", 0}})).find("~queue_size"), std::string::npos);
+  EXPECT_NE(loadError(params({{"path_length", -1}})).find("~path_length"), std::string::npos);
+  EXPECT_NE(
+      loadError(params({{"table/cell_size", 0.0}})).find("~table/cell_size must be a positive number, got 0"),
+      std::string::npos);
+  EXPECT_NE(loadError(params({{"genetic/box_x", -0.3}})).find("~genetic/box_x"), std::string::npos);
+  EXPECT_NE(loadError(params({{"mbicp/max_iterations", -1}})).find("~mbicp/max_iterations"),
+            std::string::npos);
+}
+
+TEST(Parameters, OutOfRangeValuesNameTheParameter) {
+  EXPECT_NE(loadError(params({{"genetic/crossover_rate", 1.5}}))
+                .find("~genetic/crossover_rate must be a number in [0, 1]"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"genetic/box_theta", 4.0}})).find("~genetic/box_theta"), std::string::npos);
+  EXPECT_NE(loadError(params({{"min_fitness", -0.1}})).find("~min_fitness"), std::string::npos);
+  EXPECT_NE(loadError(params({{"genetic/bits_per_gene", 40}})).find("~genetic/bits_per_gene"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"genetic/tournament_size", 30}, {"genetic/population", 20}}))
+                .find("~genetic/tournament_size"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"scan/min_range", 5.0}, {"scan/max_range", 2.0}})).find("~scan/max_range"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"odom_frame", "base_link"}})).find("~base_frame"), std::string::npos);
+}
+
+TEST(Parameters, NonFiniteNumbersAreRejectedExceptAnInfiniteMaxRange) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_NE(loadError(params({{"keyframe/distance", nan}})).find("~keyframe/distance"), std::string::npos);
+  EXPECT_NE(loadError(params({{"genetic/box_y", inf}})).find("~genetic/box_y"), std::string::npos);
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(params({{"scan/max_range", inf}}), &options, &error)) << error;
+  EXPECT_TRUE(std::isinf(options.tracker.conversion.max_range));
+}
+
+TEST(Parameters, WrongTypesNameTheParameterAndTheValue) {
+  EXPECT_EQ(loadError(params({{"genetic/population", "lots"}})),
+            "parameter ~genetic/population must be an integer in [2, 100000], got string \"lots\"");
+  EXPECT_NE(loadError(params({{"genetic/population", 20.5}})).find("~genetic/population"), std::string::npos);
+  EXPECT_EQ(loadError(params({{"publish_tf", "yes"}})),
+            "parameter ~publish_tf must be true or false, got string \"yes\"");
+  EXPECT_NE(
+      loadError(params({{"keyframe/distance", "far"}})).find("~keyframe/distance must be a positive number"),
+      std::string::npos);
+  EXPECT_NE(loadError(params({{"preset", 3}})).find("~preset must be a non-empty string, got 3"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"algorithm", "sift"}})).find("~algorithm"), std::string::npos);
+  EXPECT_NE(loadError(params({{"base_frame", true}})).find("~base_frame"), std::string::npos);
+  XmlRpcValue list;
+  list[0] = 1;
+  list[1] = 2;
+  EXPECT_NE(loadError(params({{"keyframe/angle", list}})).find("got a list"), std::string::npos);
+  EXPECT_NE(loadError(params({{"presets", 5}})).find("~presets"), std::string::npos);
+  EXPECT_NE(loadError(params({{"preset", "small"}, {"presets/small", "big"}})).find("~presets/small"),
+            std::string::npos);
+}
+
+TEST(Parameters, ErrorsInsideThePresetsFileNameTheFullPath) {
+  const std::string error =
+      loadError(params({{"preset", "large"}, {"presets/large/genetic/population", -5}}));
+  EXPECT_NE(error.find("~presets/large/genetic/population"), std::string::npos) << error;
+  // A broken preset that is not selected does not matter.
+  LaserOdometryOptions options;
+  std::string load_error;
+  EXPECT_TRUE(loadOptions(params({{"preset", "small"}, {"presets/large/genetic/population", -5}}), &options,
+                          &load_error))
+      << load_error;
+}
+
+TEST(Parameters, UnknownKeysAreWarningsNotErrors) {
+  LaserOdometryOptions options;
+  std::string error;
+  std::vector<std::string> warnings;
+  ASSERT_TRUE(loadOptions(params({{"genetic/populaton", 30},
+                                  {"publish_tf", true},
+                                  {"diagnostic_period", 1.0},
+                                  {"presets/medium/genetic/generatons", 3}}),
+                          &options, &error, &warnings))
+      << error;
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("~presets/medium/genetic/generatons"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[1].find("~genetic/populaton"), std::string::npos) << warnings[1];
+}
+
+TEST(Parameters, SummaryMentionsThePresetAndFrames) {
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(params({{"preset", "large"}}), &options, &error));
+  const std::string summary = summarize(options);
+  EXPECT_NE(summary.find("large"), std::string::npos);
+  EXPECT_NE(summary.find("odom -> base_link"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hglasm_odometry

@@ -1,0 +1,416 @@
+// Replays a bag slice through the running laser odometry (nodelet or node, per the .test file) and checks
+// what it published: one odometry, one tf and one ~match per scan, stamped with the scan stamps, no NaN,
+// few fallbacks, and the trajectory's accuracy against the slice's reference relations.
+//
+// Private parameters:
+//   bag (required)         the bag the player plays (read here for the scan stamps and wheel odometry)
+//   relations              reference relations of the slice ("" = no accuracy check)
+//   scan_topic             /scan            odom_topic   /laser_odometry/odom
+//   match_topic            /laser_odometry/match         odometry_ns  /laser_odometry
+//   odom_frame / base_frame  odom / base_link
+//   player                 /player (its pause_playback service starts the paused player)
+//   max_trans_error        metres: bound on the mean translational error over all relations
+//   max_rot_error_deg      degrees: bound on the mean rotational error over all relations
+//   max_short_trans_error  metres: the same over the relations spanning at most 10 s
+//   max_short_rot_error_deg  degrees: the same over the relations spanning at most 10 s
+//   max_fallback_ratio     bound on the fraction of matches that fell back to the prediction
+//   timeout                wall seconds for the whole replay (default 100)
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <std_srvs/SetBool.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "hglasm_odometry/Match.h"
+#include "hglasm_odometry/core/odometry_buffer.h"
+#include "hglasm_odometry/core/relations.h"
+#include "hglasm_odometry/core/scan_matcher.h"
+#include "hglasm_odometry/ros/conversions.h"
+#include "hglasm_odometry/ros/parameters.h"
+
+namespace hglasm_odometry {
+namespace {
+
+struct Settings {
+  std::string bag, relations;
+  std::string scan_topic = "/scan";
+  std::string wheel_odom_topic = "/odom";
+  std::string odom_topic = "/laser_odometry/odom";
+  std::string match_topic = "/laser_odometry/match";
+  std::string odometry_ns = "/laser_odometry";
+  std::string odom_frame = "odom";
+  std::string base_frame = "base_link";
+  std::string player = "/player";
+  double max_trans_error = 0.05;
+  double max_rot_error_deg = 1.0;
+  double max_short_trans_error = 0.05;
+  double max_short_rot_error_deg = 1.0;
+  double max_fallback_ratio = 0.1;
+  double timeout = 100.0;
+};
+
+/// Everything recorded during one replay; shared by the tests below.
+struct Recording {
+  Settings settings;
+  std::vector<ros::Time> scan_stamps;               // from the bag, sorted
+  std::vector<hglasm::StampedPose> wheel_odometry;  // from the bag, at the scan stamps
+  std::vector<nav_msgs::Odometry> odometry;
+  std::vector<Match> matches;
+  std::map<ros::Time, geometry_msgs::Transform> transforms;  // odom_frame -> base_frame by stamp
+  int foreign_transforms = 0;                                // other frame pairs seen on /tf
+  bool started = false;
+  std::mutex mutex;
+};
+
+bool topicHasSubscriber(const std::string& topic) {
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  if (!ros::master::execute("getSystemState", request, response, payload, false)) return false;
+  XmlRpc::XmlRpcValue& subscribers = payload[1];
+  for (int i = 0; i < subscribers.size(); ++i) {
+    if (static_cast<std::string>(subscribers[i][0]) == topic && subscribers[i][1].size() > 0) return true;
+  }
+  return false;
+}
+
+std::unique_ptr<Recording> record() {
+  auto rec = std::make_unique<Recording>();
+  Settings& s = rec->settings;
+  ros::NodeHandle private_nh("~");
+  private_nh.getParam("bag", s.bag);
+  private_nh.getParam("relations", s.relations);
+  private_nh.getParam("scan_topic", s.scan_topic);
+  private_nh.getParam("wheel_odom_topic", s.wheel_odom_topic);
+  private_nh.getParam("odom_topic", s.odom_topic);
+  private_nh.getParam("match_topic", s.match_topic);
+  private_nh.getParam("odometry_ns", s.odometry_ns);
+  private_nh.getParam("odom_frame", s.odom_frame);
+  private_nh.getParam("base_frame", s.base_frame);
+  private_nh.getParam("player", s.player);
+  private_nh.getParam("max_trans_error", s.max_trans_error);
+  private_nh.getParam("max_rot_error_deg", s.max_rot_error_deg);
+  private_nh.getParam("max_short_trans_error", s.max_short_trans_error);
+  private_nh.getParam("max_short_rot_error_deg", s.max_short_rot_error_deg);
+  private_nh.getParam("max_fallback_ratio", s.max_fallback_ratio);
+  private_nh.getParam("timeout", s.timeout);
+
+  // The bag's scan stamps and wheel odometry.
+  hglasm::OdometryBuffer wheel(1e9);
+  {
+    rosbag::Bag bag(s.bag, rosbag::bagmode::Read);
+    for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+      if (m.getTopic() == s.scan_topic) {
+        if (auto scan = m.instantiate<sensor_msgs::LaserScan>())
+          rec->scan_stamps.push_back(scan->header.stamp);
+      } else if (m.getTopic() == s.wheel_odom_topic) {
+        hglasm::Pose2D pose;
+        auto odom = m.instantiate<nav_msgs::Odometry>();
+        if (odom && pose2DFromOdometryMsg(*odom, &pose)) wheel.add(odom->header.stamp.toSec(), pose);
+      }
+    }
+  }
+  std::sort(rec->scan_stamps.begin(), rec->scan_stamps.end());
+  for (const ros::Time& stamp : rec->scan_stamps) {
+    hglasm::StampedPose pose;
+    pose.stamp = stamp.toSec();
+    if (wheel.poseAt(pose.stamp, 1.0, &pose.pose)) rec->wheel_odometry.push_back(pose);
+  }
+
+  ros::NodeHandle nh;
+  Recording* r = rec.get();
+  ros::Subscriber odom_sub =
+      nh.subscribe<nav_msgs::Odometry>(s.odom_topic, 10000, [r](const nav_msgs::OdometryConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(r->mutex);
+        r->odometry.push_back(*msg);
+      });
+  ros::Subscriber match_sub = nh.subscribe<Match>(s.match_topic, 10000, [r](const MatchConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(r->mutex);
+    r->matches.push_back(*msg);
+  });
+  ros::Subscriber tf_sub =
+      nh.subscribe<tf2_msgs::TFMessage>("/tf", 10000, [r](const tf2_msgs::TFMessageConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(r->mutex);
+        for (const auto& t : msg->transforms) {
+          if (stripLeadingSlash(t.header.frame_id) == r->settings.odom_frame &&
+              stripLeadingSlash(t.child_frame_id) == r->settings.base_frame) {
+            r->transforms[t.header.stamp] = t.transform;
+          } else {
+            ++r->foreign_transforms;
+          }
+        }
+      });
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+
+  // Start the (paused) player once the odometry is up and our subscriptions are connected.
+  const ros::WallTime start = ros::WallTime::now();
+  auto elapsed = [&start] { return (ros::WallTime::now() - start).toSec(); };
+  while (ros::ok() && elapsed() < 30.0 &&
+         (odom_sub.getNumPublishers() == 0 || match_sub.getNumPublishers() == 0 ||
+          tf_sub.getNumPublishers() == 0 || !topicHasSubscriber(s.scan_topic))) {
+    ros::WallDuration(0.1).sleep();
+  }
+  const std::string pause_service = s.player + "/pause_playback";
+  if (ros::service::waitForService(pause_service, ros::Duration(30.0))) {
+    std_srvs::SetBool resume;
+    resume.request.data = false;
+    rec->started = ros::service::call(pause_service, resume);
+  }
+
+  // Until every scan has its odometry, or nothing arrived for a while, or the time is up.
+  const std::size_t expected = rec->scan_stamps.size();
+  std::size_t last_count = 0;
+  ros::WallTime last_progress = ros::WallTime::now();
+  while (ros::ok() && elapsed() < s.timeout) {
+    std::size_t count;
+    {
+      std::lock_guard<std::mutex> lock(rec->mutex);
+      count = std::min(rec->odometry.size(), std::min(rec->matches.size(), rec->transforms.size()));
+    }
+    if (count >= expected) break;
+    if (count != last_count) {
+      last_count = count;
+      last_progress = ros::WallTime::now();
+    } else if ((ros::WallTime::now() - last_progress).toSec() > 20.0) {
+      break;
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+  ros::WallDuration(0.5).sleep();  // anything still in flight (e.g. a duplicate) is caught too
+  spinner.stop();
+  std::lock_guard<std::mutex> lock(rec->mutex);
+  ROS_INFO("replay took %.1f s wall: %zu scans in the bag, %zu odometry, %zu match, %zu tf received",
+           elapsed(), expected, rec->odometry.size(), rec->matches.size(), rec->transforms.size());
+  return rec;
+}
+
+bool allFinite(const boost::array<double, 36>& values) {
+  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+}
+
+class OdometryReplay : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!recording_) recording_ = record();
+  }
+  static std::unique_ptr<Recording> recording_;
+};
+std::unique_ptr<Recording> OdometryReplay::recording_;
+
+TEST_F(OdometryReplay, PlayerStartedAndTheBagHasScans) {
+  EXPECT_TRUE(recording_->started) << "could not resume " << recording_->settings.player;
+  EXPECT_GT(recording_->scan_stamps.size(), 100u);
+}
+
+TEST_F(OdometryReplay, OneOdometryPerScanStampedWithTheScanStamp) {
+  const Recording& r = *recording_;
+  std::vector<ros::Time> stamps;
+  for (const auto& odom : r.odometry) {
+    stamps.push_back(odom.header.stamp);
+    EXPECT_EQ(stripLeadingSlash(odom.header.frame_id), r.settings.odom_frame);
+    EXPECT_EQ(stripLeadingSlash(odom.child_frame_id), r.settings.base_frame);
+  }
+  ASSERT_EQ(stamps.size(), r.scan_stamps.size()) << "odometry messages vs scans in the bag";
+  EXPECT_TRUE(std::is_sorted(stamps.begin(), stamps.end())) << "odometry published out of order";
+  std::sort(stamps.begin(), stamps.end());
+  EXPECT_EQ(stamps, r.scan_stamps) << "odometry stamps differ from the scan stamps";
+}
+
+TEST_F(OdometryReplay, OneMatchPerScanStampedWithTheScanStamp) {
+  const Recording& r = *recording_;
+  std::vector<ros::Time> stamps;
+  std::uint32_t max_dropped = 0;
+  for (const auto& match : r.matches) {
+    stamps.push_back(match.header.stamp);
+    max_dropped = std::max(max_dropped, match.dropped_scans);
+  }
+  std::sort(stamps.begin(), stamps.end());
+  EXPECT_EQ(stamps, r.scan_stamps);
+  EXPECT_EQ(max_dropped, 0u) << "the input queue dropped scans";
+  ASSERT_FALSE(r.matches.empty());
+  EXPECT_TRUE(r.matches.front().reset) << "the first scan starts the odometry";
+}
+
+TEST_F(OdometryReplay, TfForEveryScanEqualsTheOdometry) {
+  const Recording& r = *recording_;
+  ASSERT_EQ(r.transforms.size(), r.scan_stamps.size())
+      << r.settings.odom_frame << " -> " << r.settings.base_frame;
+  for (const auto& odom : r.odometry) {
+    auto it = r.transforms.find(odom.header.stamp);
+    ASSERT_NE(it, r.transforms.end()) << "no tf at " << odom.header.stamp;
+    EXPECT_NEAR(it->second.translation.x, odom.pose.pose.position.x, 1e-9);
+    EXPECT_NEAR(it->second.translation.y, odom.pose.pose.position.y, 1e-9);
+    EXPECT_NEAR(it->second.rotation.z, odom.pose.pose.orientation.z, 1e-9);
+    EXPECT_NEAR(it->second.rotation.w, odom.pose.pose.orientation.w, 1e-9);
+  }
+}
+
+TEST_F(OdometryReplay, NeverPublishesNaN) {
+  const Recording& r = *recording_;
+  ASSERT_FALSE(r.odometry.empty());
+  for (const auto& odom : r.odometry) {
+    const auto& p = odom.pose.pose;
+    ASSERT_TRUE(std::isfinite(p.position.x) && std::isfinite(p.position.y) && std::isfinite(p.position.z));
+    ASSERT_TRUE(std::isfinite(p.orientation.z) && std::isfinite(p.orientation.w));
+    ASSERT_TRUE(allFinite(odom.pose.covariance) && allFinite(odom.twist.covariance));
+    const auto& v = odom.twist.twist;
+    ASSERT_TRUE(std::isfinite(v.linear.x) && std::isfinite(v.linear.y) && std::isfinite(v.angular.z));
+    for (int i = 0; i < 6; ++i) ASSERT_GE(odom.pose.covariance[i * 6 + i], 0.0);
+  }
+  for (const auto& m : r.matches) {
+    for (float value :
+         {m.fitness_ratio, m.rms_error, m.table_build_ms, m.prealign_ms, m.refine_ms, m.total_ms}) {
+      ASSERT_TRUE(std::isfinite(value));
+    }
+    for (const auto* pose : {&m.guess_pose, &m.prealigned_pose, &m.final_pose}) {
+      ASSERT_TRUE(std::isfinite(pose->x) && std::isfinite(pose->y) && std::isfinite(pose->theta));
+    }
+  }
+}
+
+TEST_F(OdometryReplay, FallbacksAreRare) {
+  const Recording& r = *recording_;
+  int matched = 0, fallbacks = 0, resets = 0;
+  double total_ms = 0.0;
+  for (const auto& m : r.matches) {
+    matched += m.matched;
+    fallbacks += m.matched && m.fallback;
+    resets += m.reset;
+    total_ms += m.total_ms;
+  }
+  ASSERT_GT(matched, 0);
+  const double ratio = static_cast<double>(fallbacks) / matched;
+  std::printf("[measured] %d matches, %d fallbacks (ratio %.4f), %d resets, %.2f ms per scan (wall)\n",
+              matched, fallbacks, ratio, resets, total_ms / r.matches.size());
+  EXPECT_EQ(resets, 1) << "only the first scan starts the odometry";
+  EXPECT_LE(ratio, r.settings.max_fallback_ratio);
+}
+
+TEST_F(OdometryReplay, TrajectoryMatchesTheReferenceRelations) {
+  const Recording& r = *recording_;
+  if (r.settings.relations.empty()) GTEST_SKIP() << "no relations given";
+  std::vector<hglasm::Relation> relations;
+  std::string error;
+  ASSERT_TRUE(hglasm::readRelations(r.settings.relations, &relations, &error)) << error;
+  ASSERT_FALSE(relations.empty());
+
+  std::vector<hglasm::StampedPose> trajectory;
+  for (const auto& odom : r.odometry) {
+    hglasm::StampedPose pose;
+    pose.stamp = odom.header.stamp.toSec();
+    ASSERT_TRUE(pose2DFromOdometryMsg(odom, &pose.pose));
+    trajectory.push_back(pose);
+  }
+  std::sort(trajectory.begin(), trajectory.end(),
+            [](const hglasm::StampedPose& a, const hglasm::StampedPose& b) { return a.stamp < b.stamp; });
+  constexpr double kShortSpan = 10.0;  // seconds: relations this short measure local accuracy, not drift
+  const hglasm::RelationStats laser = hglasm::evaluateRelations(relations, trajectory, 0.0);
+  const hglasm::RelationStats wheel = hglasm::evaluateRelations(relations, r.wheel_odometry, 0.0);
+  const hglasm::RelationStats laser_short = hglasm::evaluateRelations(relations, trajectory, kShortSpan);
+  const hglasm::RelationStats wheel_short =
+      hglasm::evaluateRelations(relations, r.wheel_odometry, kShortSpan);
+  for (const auto* pair : {&laser, &laser_short}) {
+    const bool all = pair == &laser;
+    const hglasm::RelationStats& w = all ? wheel : wheel_short;
+    std::printf(
+        "[measured] %s: %d relations: laser odometry trans %.4f +- %.4f m, rot %.3f +- %.3f deg; "
+        "wheel odometry trans %.4f +- %.4f m, rot %.3f +- %.3f deg\n",
+        all ? "all" : "<= 10 s", pair->count, pair->trans_mean, pair->trans_std, pair->rot_mean_deg,
+        pair->rot_std_deg, w.trans_mean, w.trans_std, w.rot_mean_deg, w.rot_std_deg);
+  }
+  EXPECT_EQ(laser.missing, 0) << "relations whose stamps have no odometry";
+  EXPECT_EQ(laser.count, static_cast<int>(relations.size()));
+  EXPECT_LE(laser.trans_mean, r.settings.max_trans_error) << "all relations";
+  EXPECT_LE(laser.rot_mean_deg, r.settings.max_rot_error_deg) << "all relations";
+  EXPECT_GT(laser_short.count, 0);
+  EXPECT_LE(laser_short.trans_mean, r.settings.max_short_trans_error) << "relations <= 10 s";
+  EXPECT_LE(laser_short.rot_mean_deg, r.settings.max_short_rot_error_deg) << "relations <= 10 s";
+}
+
+/// config/presets.yaml (loaded by the launch file under the odometry's ~presets) must carry exactly the
+/// built-in values of hglasm::presetOptions, and the shipped YAML must validate for every preset.
+TEST_F(OdometryReplay, ShippedYamlValidatesAndMatchesTheBuiltInPresets) {
+  XmlRpc::XmlRpcValue params;
+  ASSERT_TRUE(ros::NodeHandle().getParam(recording_->settings.odometry_ns, params));
+  XmlRpc::XmlRpcValue presets_only;
+  presets_only["presets"] = params["presets"];
+  for (const char* name : {"small", "medium", "large"}) {
+    hglasm::Preset preset;
+    ASSERT_TRUE(hglasm::parsePreset(name, &preset));
+    const hglasm::MatcherOptions expected = hglasm::presetOptions(preset);
+    for (XmlRpc::XmlRpcValue* root : {&params, &presets_only}) {
+      (*root)["preset"] = name;
+      LaserOdometryOptions options;
+      std::string error;
+      std::vector<std::string> warnings;
+      ASSERT_TRUE(loadOptions(*root, &options, &error, &warnings)) << error;
+      EXPECT_TRUE(warnings.empty()) << warnings.front();
+      if (root != &presets_only) continue;
+      const hglasm::MatcherOptions& got = options.tracker.matcher;
+      const hglasm::GeneticOptions &g = got.genetic, &e = expected.genetic;
+      EXPECT_EQ(got.algorithm, expected.algorithm) << name;
+      EXPECT_DOUBLE_EQ(g.box.half_x, e.box.half_x) << name;
+      EXPECT_DOUBLE_EQ(g.box.half_y, e.box.half_y) << name;
+      EXPECT_DOUBLE_EQ(g.box.half_theta, e.box.half_theta) << name;
+      EXPECT_EQ(g.population, e.population) << name;
+      EXPECT_EQ(g.generations, e.generations) << name;
+      EXPECT_EQ(g.runs, e.runs) << name;
+      EXPECT_EQ(g.bits_per_gene, e.bits_per_gene) << name;
+      EXPECT_DOUBLE_EQ(g.crossover_rate, e.crossover_rate) << name;
+      EXPECT_DOUBLE_EQ(g.mutation_rate, e.mutation_rate) << name;
+      EXPECT_EQ(g.tournament_size, e.tournament_size) << name;
+      EXPECT_EQ(g.elite_count, e.elite_count) << name;
+      EXPECT_EQ(g.max_points, e.max_points) << name;
+      EXPECT_EQ(g.polish_evaluations, e.polish_evaluations) << name;
+      EXPECT_EQ(g.coarse_generations, e.coarse_generations) << name;
+      EXPECT_EQ(g.seed, e.seed) << name;
+      for (int t = 0; t < 2; ++t) {
+        const hglasm::LookupTableOptions& a = t == 0 ? got.table : got.coarse_table;
+        const hglasm::LookupTableOptions& b = t == 0 ? expected.table : expected.coarse_table;
+        EXPECT_DOUBLE_EQ(a.cell_size, b.cell_size) << name << " table " << t;
+        EXPECT_DOUBLE_EQ(a.sigma, b.sigma) << name << " table " << t;
+        EXPECT_DOUBLE_EQ(a.cutoff, b.cutoff) << name << " table " << t;
+        EXPECT_DOUBLE_EQ(a.segment_max_gap, b.segment_max_gap) << name << " table " << t;
+        EXPECT_DOUBLE_EQ(a.segment_gap_per_metre, b.segment_gap_per_metre) << name << " table " << t;
+      }
+      const hglasm::MbicpOptions &m = got.mbicp, &n = expected.mbicp;
+      EXPECT_DOUBLE_EQ(m.metric_l, n.metric_l) << name;
+      EXPECT_DOUBLE_EQ(m.bearing_window, n.bearing_window) << name;
+      EXPECT_DOUBLE_EQ(m.max_distance, n.max_distance) << name;
+      EXPECT_DOUBLE_EQ(m.segment_max_gap, n.segment_max_gap) << name;
+      EXPECT_DOUBLE_EQ(m.segment_gap_per_metre, n.segment_gap_per_metre) << name;
+      EXPECT_DOUBLE_EQ(m.trim_fraction, n.trim_fraction) << name;
+      EXPECT_EQ(m.max_iterations, n.max_iterations) << name;
+      EXPECT_DOUBLE_EQ(m.error_ratio, n.error_ratio) << name;
+      EXPECT_DOUBLE_EQ(m.min_step_xy, n.min_step_xy) << name;
+      EXPECT_DOUBLE_EQ(m.min_step_theta, n.min_step_theta) << name;
+      EXPECT_EQ(m.converged_iterations, n.converged_iterations) << name;
+      EXPECT_DOUBLE_EQ(m.min_association_ratio, n.min_association_ratio) << name;
+      EXPECT_DOUBLE_EQ(m.degenerate_eigenvalue, n.degenerate_eigenvalue) << name;
+      EXPECT_EQ(m.point_to_line, n.point_to_line) << name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hglasm_odometry
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "odometry_rostest");
+  ros::NodeHandle nh;  // keeps the node alive for the whole run
+  return RUN_ALL_TESTS();
+}
