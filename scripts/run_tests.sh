@@ -11,8 +11,8 @@ source scripts/env.sh
 echo "== build (Release) into $HGLASM_BUILD"
 hglasm_build
 hglasm_build --target tests
-source "$HGLASM_BUILD/devel/setup.bash"
 
+# ctest runs each test through devel/env.sh, which sets up the ROS environment itself.
 echo "== gtest + rostest + launch check (ctest)"
 (cd "$HGLASM_BUILD" && ctest --output-on-failure)
 
