@@ -33,9 +33,11 @@ if [ -f test/fuzz/fuzz_scan_matcher.cpp ]; then
       -DCMAKE_BUILD_TYPE=RelWithDebInfo
   fi
   cmake --build "$FUZZ_BUILD" -j"$(nproc)" --target fuzz_scan_matcher
-  # Regression inputs first (every crash ever found is kept in test/fuzz/corpus), then new exploration.
+  # Every input that ever crashed is kept in test/fuzz/corpus: replayed first (regressions), then the
+  # fuzzer explores from them for a bounded time; new interesting inputs go to the build's own corpus.
   mkdir -p "$FUZZ_BUILD/corpus"
-  "$FUZZ_BUILD/fuzz_scan_matcher" -max_total_time="${HGLASM_FUZZ_SECONDS:-60}" -print_final_stats=1 \
-    "$FUZZ_BUILD/corpus" test/fuzz/corpus
+  "$FUZZ_BUILD/fuzz_scan_matcher" -runs=0 test/fuzz/corpus
+  "$FUZZ_BUILD/fuzz_scan_matcher" -max_total_time="${HGLASM_FUZZ_SECONDS:-60}" -rss_limit_mb=2048 \
+    -print_final_stats=1 "$FUZZ_BUILD/corpus" test/fuzz/corpus
 fi
 echo "== all tests passed"

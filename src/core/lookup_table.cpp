@@ -59,7 +59,12 @@ void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
   const double spacing = std::max(options_.cell_size, 0.5 * options_.sigma);
   const Eigen::Vector2d* previous = nullptr;
   for (const auto& p : reference) {
-    if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
+    // Points beyond kMaxCoordinate get no cell (below); they must not be joined either: the joining gap
+    // grows with the range, and two wild readings 1e30 m out would be joined by billions of samples.
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || std::abs(p.x()) > kMaxCoordinate ||
+        std::abs(p.y()) > kMaxCoordinate) {
+      continue;
+    }
     if (previous && options_.segment_max_gap > 0.0) {
       const double range = std::min(previous->norm(), p.norm());
       const double max_gap = options_.segment_max_gap + options_.segment_gap_per_metre * range;

@@ -1,0 +1,550 @@
+// The core rows of the robustness matrix (issue 5): bad scans, broken scan geometry, odd laser layouts,
+// time faults and wheel-odometry faults fed to the OdometryTracker through the same conversion the ROS
+// layer uses (RangeScan -> scanFromRanges -> processScan). Every update must be finite and every fault
+// must be visible in the update (fallback, prediction source, reset, warning).
+//
+// Rows already covered elsewhere (not repeated here): duplicate stamps
+// (test_odometry_tracker.cpp DuplicateStampsNeverGiveNaN), a single backward / forward time jump
+// (TimeGoingBackwardsResets, TimeJumpingForwardResets), no wheel odometry at all
+// (FollowsACircleWithoutWheelOdometry), an empty Scan{} (EmptyScansFallBackToTheOdometryGuess).
+#include "hglasm_odometry/core/odometry_tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_util.h"
+
+namespace {
+
+using hglasm::OdometryTracker;
+using hglasm::Pose2D;
+using hglasm::PredictionSource;
+using hglasm::RangeScan;
+using hglasm::TrackerOptions;
+using hglasm::TrackerUpdate;
+using hglasm_test::deg;
+using hglasm_test::LaserSpec;
+using Path = std::function<Pose2D(double)>;
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+/// Clockwise circle of radius 1.5 m through the origin at 0.5 m/s (clear of the room's obstacles).
+Pose2D circlePath(double t) {
+  const double radius = 1.5, rate = 0.5 / radius;
+  return hglasm_test::rawPose(radius * std::sin(rate * t), -radius + radius * std::cos(rate * t),
+                              hglasm_test::angleDiff(-rate * t, 0.0));
+}
+
+/// Forward at `speed` while turning at `rate`: with a 360-degree laser the +-pi seam sweeps over the room.
+Path arcPath(double speed, double rate) {
+  return [speed, rate](double t) {
+    if (std::abs(rate) < 1e-12) return hglasm_test::rawPose(speed * t, 0.0, 0.0);
+    const double r = speed / rate;
+    return hglasm_test::rawPose(r * std::sin(rate * t), r - r * std::cos(rate * t),
+                                hglasm_test::angleDiff(rate * t, 0.0));
+  };
+}
+
+std::string describe(const TrackerUpdate& u) {
+  std::ostringstream text;
+  text << "stamp " << u.stamp << " pose " << u.pose.x << " " << u.pose.y << " " << u.pose.theta << " matched "
+       << u.matched << " fallback " << u.fallback << " status " << hglasm::toString(u.match.status)
+       << " fitness " << u.match.fitness_ratio << " prediction " << hglasm::toString(u.prediction)
+       << " keyframe " << u.new_keyframe << " reset " << u.reset << " warning '" << u.warning << "'";
+  return text.str();
+}
+
+/// Never NaN, never an invalid covariance, whatever went in.
+void expectSane(const TrackerUpdate& u) {
+  EXPECT_TRUE(u.pose.isFinite()) << describe(u);
+  EXPECT_TRUE(u.guess.isFinite()) << describe(u);
+  EXPECT_TRUE(u.velocity.allFinite()) << describe(u);
+  EXPECT_TRUE(hglasm_test::isValidCovariance(u.pose_covariance)) << describe(u) << "\n" << u.pose_covariance;
+  EXPECT_TRUE(hglasm_test::isValidCovariance(u.velocity_covariance)) << describe(u);
+  EXPECT_TRUE(u.match.pose.isFinite()) << describe(u);
+  EXPECT_TRUE(u.match.covariance.allFinite()) << describe(u);
+}
+
+/// A simulated robot whose scans go through the core's own RangeScan conversion (as in the ROS layer),
+/// with optional wheel odometry at 50 Hz that can be delayed or corrupted.
+class Robot {
+ public:
+  Robot(const TrackerOptions& options, Path path, LaserSpec laser = hglasm_test::halfCircleLaser(),
+        hglasm_test::World world = hglasm_test::room())
+      : tracker_(options), path_(std::move(path)), world_(std::move(world)), laser_(laser) {}
+
+  void setLaser(const LaserSpec& laser) { laser_ = laser; }
+  /// Exact wheel odometry (the truth), optionally with a permanent offset added from `jump_time` on.
+  void enableOdometry(double jump_time = std::numeric_limits<double>::infinity(),
+                      const Pose2D& jump = Pose2D()) {
+    odometry_ = true;
+    jump_time_ = jump_time;
+    jump_ = jump;
+  }
+  /// Odometry samples are handed to the tracker only `delay` seconds after their stamp.
+  void setOdometryDelay(double delay) { odometry_delay_ = delay; }
+
+  Pose2D truth(double t) const { return path_(t); }
+  RangeScan rangesAt(double t) const { return hglasm_test::simulateRanges(world_, path_(t), laser_); }
+
+  /// The clock of the scans and the odometry is ahead of the simulated time by `offset` from now on.
+  void setStampOffset(double offset) { stamp_offset_ = offset; }
+
+  /// Feeds the odometry available at wall time t (stamps <= t - delay), then the scan taken at t.
+  TrackerUpdate step(double t, const RangeScan* ranges = nullptr) {
+    return stepAt(t, t + stamp_offset_, ranges);
+  }
+
+  /// As step(), but the scan carries `stamp` (time faults) while the world is seen at `t`.
+  TrackerUpdate stepAt(double t, double stamp, const RangeScan* ranges = nullptr) {
+    if (odometry_) {
+      while (odometry_time_ + 0.02 <= t - odometry_delay_ + 1e-9) {
+        odometry_time_ += 0.02;
+        Pose2D pose = path_(odometry_time_);
+        if (odometry_time_ >= jump_time_) pose = hglasm_test::composeByHand(jump_, pose);
+        tracker_.addOdometry(odometry_time_ + stamp_offset_, pose);
+      }
+    }
+    const RangeScan scan = ranges ? *ranges : rangesAt(t);
+    hglasm::ScanError error = hglasm::ScanError::kNone;
+    const hglasm::Scan points = hglasm::scanFromRanges(scan, tracker_.options().conversion, &error);
+    last_error_ = error;
+    const TrackerUpdate update = tracker_.processScan(stamp, points);
+    expectSane(update);
+    if (!update.warning.empty()) warnings_.push_back(update.warning);
+    return update;
+  }
+
+  OdometryTracker& tracker() { return tracker_; }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  hglasm::ScanError lastError() const { return last_error_; }
+
+ private:
+  OdometryTracker tracker_;
+  Path path_;
+  hglasm_test::World world_;
+  LaserSpec laser_;
+  bool odometry_ = false;
+  double odometry_time_ = -0.02;  // the first sample is at t = 0
+  double odometry_delay_ = 0.0;
+  double stamp_offset_ = 0.0;
+  double jump_time_ = std::numeric_limits<double>::infinity();
+  Pose2D jump_;
+  std::vector<std::string> warnings_;
+  hglasm::ScanError last_error_ = hglasm::ScanError::kNone;
+};
+
+TrackerOptions withoutOdometry() {
+  TrackerOptions options;
+  options.use_odometry = false;
+  return options;
+}
+
+void expectNear(const Pose2D& estimate, const Pose2D& truth, double max_translation, double max_rotation,
+                const std::string& what) {
+  EXPECT_LT(hglasm_test::translationError(estimate, truth), max_translation)
+      << what << ": " << estimate.x << " " << estimate.y << " " << estimate.theta << " vs " << truth.x << " "
+      << truth.y << " " << truth.theta;
+  EXPECT_LT(hglasm_test::rotationError(estimate, truth), max_rotation)
+      << what << ": " << estimate.theta << " vs " << truth.theta;
+}
+
+// ------------------------------------------------------------------ bad scans
+
+/// The three "nothing to match" scans, as a driver could publish them.
+std::vector<std::pair<std::string, RangeScan>> unusableScans(const RangeScan& good) {
+  std::vector<std::pair<std::string, RangeScan>> scans;
+  RangeScan empty = good;
+  empty.ranges.clear();
+  scans.emplace_back("no beams", empty);
+  RangeScan invalid = good;
+  const float bad[] = {kNaN,
+                       kInf,
+                       -kInf,
+                       0.0f,
+                       -1.0f,
+                       static_cast<float>(good.range_max) + 5.0f,
+                       static_cast<float>(good.range_min) * 0.5f};
+  for (std::size_t i = 0; i < invalid.ranges.size(); ++i) invalid.ranges[i] = bad[i % 7];
+  scans.emplace_back("all ranges invalid", invalid);
+  RangeScan single = invalid;
+  single.ranges[single.ranges.size() / 2] = 2.0f;
+  scans.emplace_back("a single valid point", single);
+  return scans;
+}
+
+TEST(Robustness, UnusableScansAreFlaggedAndIntegrateTheOdometryGuess) {
+  Robot robot(TrackerOptions(), circlePath);
+  robot.enableOdometry();  // exact wheel odometry: the fallback must follow it
+  for (int i = 0; i <= 10; ++i) robot.step(0.1 * i);
+  double previous_trace = robot.step(1.1).pose_covariance.trace();
+  int i = 12;
+  for (const auto& [what, ranges] : unusableScans(robot.rangesAt(0.0))) {
+    SCOPED_TRACE(what);
+    for (int k = 0; k < 3; ++k, ++i) {
+      const TrackerUpdate update = robot.step(0.1 * i, &ranges);
+      EXPECT_TRUE(update.published) << describe(update);
+      EXPECT_TRUE(update.fallback) << describe(update);
+      EXPECT_FALSE(update.new_keyframe) << describe(update);  // the keyframe is kept for when scans return
+      EXPECT_EQ(update.match.status, hglasm::MatchStatus::kTooFewPoints) << describe(update);
+      EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+      expectNear(update.pose, robot.truth(0.1 * i), 0.005, deg(0.1), describe(update));
+      EXPECT_GT(update.pose_covariance.trace(), previous_trace) << describe(update);  // uncertainty grows
+      previous_trace = update.pose_covariance.trace();
+    }
+  }
+  // Unusable scans are flagged, not warned about (the ROS layer reports a broken scan once).
+  EXPECT_TRUE(robot.warnings().empty()) << robot.warnings().front();
+  // Valid scans again: tracking resumes with matches, not fallbacks.
+  TrackerUpdate update;
+  for (int k = 0; k < 10; ++k, ++i) {
+    update = robot.step(0.1 * i);
+    EXPECT_TRUE(update.matched) << describe(update);
+    EXPECT_FALSE(update.fallback) << describe(update);
+  }
+  expectNear(update.pose, robot.truth(0.1 * (i - 1)), 0.02, deg(0.3), "after the bad scans");
+}
+
+TEST(Robustness, UnusableScansWithoutOdometryKeepTheConstantVelocity) {
+  Robot robot(withoutOdometry(), arcPath(0.4, 0.1));
+  for (int i = 0; i <= 10; ++i) robot.step(0.1 * i);
+  int i = 11;
+  for (const auto& [what, ranges] : unusableScans(robot.rangesAt(0.0))) {
+    SCOPED_TRACE(what);
+    const TrackerUpdate update = robot.step(0.1 * i++, &ranges);
+    EXPECT_TRUE(update.fallback) << describe(update);
+    EXPECT_EQ(update.prediction, PredictionSource::kConstantVelocity) << describe(update);
+  }
+  // 0.3 s of constant-velocity prediction on a gentle arc stays within a few millimetres.
+  expectNear(robot.tracker().pose(), robot.truth(0.1 * (i - 1)), 0.01, deg(0.2), "after the bad scans");
+}
+
+TEST(Robustness, StructurallyBrokenScansAreFallbacksToo) {
+  Robot robot(TrackerOptions(), circlePath);
+  robot.enableOdometry();
+  for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
+  RangeScan zero_increment = robot.rangesAt(0.6);
+  zero_increment.angle_increment = 0.0;
+  RangeScan nan_angle = robot.rangesAt(0.7);
+  nan_angle.angle_min = std::numeric_limits<double>::quiet_NaN();
+  RangeScan bad_limits = robot.rangesAt(0.8);
+  bad_limits.range_min = 10.0;
+  bad_limits.range_max = 1.0;
+  int i = 6;
+  for (const RangeScan* scan : {&zero_increment, &nan_angle, &bad_limits}) {
+    const TrackerUpdate update = robot.step(0.1 * i, scan);
+    EXPECT_NE(robot.lastError(), hglasm::ScanError::kNone);
+    EXPECT_TRUE(update.fallback) << describe(update);
+    expectNear(update.pose, robot.truth(0.1 * i), 0.005, deg(0.1), describe(update));
+    ++i;
+  }
+}
+
+TEST(Robustness, InvalidRangesMixedInLeaveTheEstimateUnchanged) {
+  // Two identical robots; one laser reports a third of its beams as NaN, +-inf, 0, negative, below
+  // range_min or beyond range_max (REP-117: all invalid). Both estimates must agree.
+  Robot clean(withoutOdometry(), circlePath);
+  Robot dirty(withoutOdometry(), circlePath);
+  const float bad[] = {kNaN, kInf, -kInf, 0.0f, -3.0f, 0.01f, 45.0f, 1e30f};
+  TrackerUpdate a, b;
+  for (int i = 0; i <= 60; ++i) {
+    const double t = 0.1 * i;
+    RangeScan ranges = clean.rangesAt(t);
+    a = clean.step(t, &ranges);
+    for (std::size_t k = (i % 3); k < ranges.ranges.size(); k += 3) ranges.ranges[k] = bad[(k / 3 + i) % 8];
+    b = dirty.step(t, &ranges);
+    if (i == 0) continue;
+    EXPECT_FALSE(b.fallback) << describe(b);
+    expectNear(b.pose, a.pose, 0.01, deg(0.2), "dirty vs clean at scan " + std::to_string(i));
+  }
+  expectNear(b.pose, clean.truth(6.0), 0.03, deg(0.5), "dirty vs truth");
+}
+
+// ------------------------------------------------------------------ scanner geometry
+
+TEST(Robustness, BeamCountChangeMakesANewKeyframeWithOneWarningAndContinues) {
+  Robot robot(withoutOdometry(), circlePath);
+  for (int i = 0; i <= 15; ++i) robot.step(0.1 * i);
+  ASSERT_TRUE(robot.warnings().empty());
+  // The driver is reconfigured: 270 degrees with 541 beams instead of 180 degrees with 361.
+  robot.setLaser(hglasm_test::laserSpec(deg(270.0), 541));
+  const TrackerUpdate changed = robot.step(1.6);
+  EXPECT_TRUE(changed.new_keyframe) << describe(changed);
+  EXPECT_FALSE(changed.fallback) << describe(changed);  // the points still match the old reference
+  EXPECT_NE(changed.warning.find("beam count"), std::string::npos) << describe(changed);
+  TrackerUpdate update;
+  for (int i = 17; i <= 40; ++i) {
+    update = robot.step(0.1 * i);
+    EXPECT_TRUE(update.matched) << describe(update);
+    EXPECT_FALSE(update.fallback) << describe(update);
+  }
+  EXPECT_EQ(robot.warnings().size(), 1u);  // one warning for one event
+  expectNear(update.pose, robot.truth(4.0), 0.03, deg(0.5), "after the change");
+}
+
+TEST(Robustness, AngleIncrementChangeWithTheSameBeamCountStillTracks) {
+  // The core cannot see an increment change with the same beam count (the ROS layer requests a keyframe
+  // for it, see test/rostest/robustness_rostest.cpp); the points stay metric, so matching still works.
+  Robot robot(withoutOdometry(), circlePath);
+  for (int i = 0; i <= 10; ++i) robot.step(0.1 * i);
+  robot.setLaser(hglasm_test::laserSpec(deg(240.0), 361));
+  robot.tracker().requestKeyframe();
+  const TrackerUpdate changed = robot.step(1.1);
+  EXPECT_TRUE(changed.new_keyframe) << describe(changed);
+  EXPECT_FALSE(changed.fallback) << describe(changed);
+  TrackerUpdate update;
+  for (int i = 12; i <= 30; ++i) {
+    update = robot.step(0.1 * i);
+    EXPECT_FALSE(update.fallback) << describe(update);
+  }
+  expectNear(update.pose, robot.truth(3.0), 0.03, deg(0.5), "after the change");
+}
+
+struct LaserCase {
+  std::string name;
+  LaserSpec laser;
+  Path path;
+  double seconds;
+};
+
+class LaserLayouts : public testing::TestWithParam<int> {};
+
+std::vector<LaserCase> laserCases() {
+  return {
+      {"descending_180deg", hglasm_test::laserSpec(hglasm_test::kPi, 361, true), circlePath, 5.0},
+      {"descending_270deg_1081", hglasm_test::laserSpec(deg(270.0), 1081, true), circlePath, 4.0},
+      // Full turn and a half on an arc: the seam at +-pi sweeps over every wall.
+      {"full_circle_across_the_seam", hglasm_test::fullCircleLaser(360), arcPath(0.2, 0.8), 12.0},
+      {"full_circle_descending", hglasm_test::laserSpec(2.0 * hglasm_test::kPi, 720, true),
+       arcPath(0.2, -0.8), 8.0},
+      {"more_than_2000_beams", hglasm_test::laserSpec(deg(270.0), 2161), circlePath, 4.0},
+      {"full_circle_4000_beams", hglasm_test::fullCircleLaser(4000), arcPath(0.3, 0.5), 4.0},
+  };
+}
+
+TEST_P(LaserLayouts, CorrectEstimate) {
+  const LaserCase c = laserCases()[GetParam()];
+  Robot robot(withoutOdometry(), c.path, c.laser);
+  TrackerUpdate update;
+  int fallbacks = 0;
+  const int steps = static_cast<int>(std::lround(c.seconds * 10.0));
+  for (int i = 0; i <= steps; ++i) {
+    update = robot.step(0.1 * i);
+    if (i > 0 && update.fallback) ++fallbacks;
+  }
+  EXPECT_EQ(fallbacks, 0);
+  EXPECT_TRUE(robot.warnings().empty()) << robot.warnings().front();
+  expectNear(update.pose, robot.truth(0.1 * steps), 0.03, deg(0.5), c.name);
+}
+
+INSTANTIATE_TEST_SUITE_P(Robustness, LaserLayouts, testing::Range(0, 6),
+                         [](const testing::TestParamInfo<int>& info) {
+                           return laserCases()[info.param].name;
+                         });
+
+// ------------------------------------------------------------------ time faults
+
+TEST(Robustness, LoopedSequenceResetsOnceAndRepeatsItself) {
+  // A bag played with --loop: the stamps jump back to the start. One reset, one warning, and the second
+  // pass reproduces the first (same scans from the same origin; the tracker's GA seed is per match, so
+  // allow millimetres).
+  Robot robot(withoutOdometry(), circlePath);
+  std::vector<Pose2D> first;
+  for (int i = 0; i <= 30; ++i) first.push_back(robot.step(0.1 * i).pose);
+  int resets = 0;
+  for (int i = 0; i <= 30; ++i) {
+    const TrackerUpdate update = robot.step(0.1 * i);
+    if (update.reset) ++resets;
+    EXPECT_EQ(update.reset, i == 0) << describe(update);
+    expectNear(update.pose, first[i], 0.01, deg(0.2), "second pass, scan " + std::to_string(i));
+  }
+  EXPECT_EQ(resets, 1);
+  ASSERT_EQ(robot.warnings().size(), 1u);
+  EXPECT_NE(robot.warnings()[0].find("back"), std::string::npos) << robot.warnings()[0];
+}
+
+TEST(Robustness, StampsJumpingForwardByMinutesResetOnceAndContinue) {
+  Robot robot(withoutOdometry(), circlePath);
+  for (int i = 0; i <= 10; ++i) robot.step(0.1 * i);
+  const double offset = 300.0;  // five minutes (the scanner's clock was corrected)
+  const TrackerUpdate jump = robot.stepAt(1.1, 1.1 + offset);
+  EXPECT_TRUE(jump.reset) << describe(jump);
+  EXPECT_EQ(jump.pose.x, 0.0);
+  TrackerUpdate update;
+  for (int i = 12; i <= 30; ++i) {
+    update = robot.stepAt(0.1 * i, 0.1 * i + offset);
+    EXPECT_FALSE(update.reset) << describe(update);
+    EXPECT_FALSE(update.fallback) << describe(update);
+  }
+  ASSERT_EQ(robot.warnings().size(), 1u);
+  EXPECT_NE(robot.warnings()[0].find("forward"), std::string::npos) << robot.warnings()[0];
+  // Tracked from the new origin: the motion since 1.1 s.
+  const Pose2D since_reset = hglasm_test::relativeByHand(robot.truth(1.1), robot.truth(3.0));
+  expectNear(update.pose, since_reset, 0.03, deg(0.5), "since the reset");
+  // A forward gap below max_time_jump (a dropped second of scans) is not a reset.
+  const TrackerUpdate gap = robot.stepAt(3.5, 3.5 + offset);
+  EXPECT_FALSE(gap.reset) << describe(gap);
+}
+
+TEST(Robustness, ClockGoingBackWhileMovingResetsOnceAndKeepsUsingTheOdometry) {
+  // The robot's clock steps back by 2 s (NTP, a restarted driver) while it drives: scans and wheel odometry
+  // carry stamps that were used before, for other poses. The old odometry history must not be mixed
+  // with the new samples (every prediction would be a jump).
+  Robot robot(TrackerOptions(), circlePath);
+  robot.enableOdometry();
+  for (int i = 0; i <= 30; ++i) robot.step(0.1 * i);
+  robot.setStampOffset(-2.0);
+  const TrackerUpdate back = robot.step(3.1);
+  EXPECT_TRUE(back.reset) << describe(back);
+  TrackerUpdate update;
+  for (int i = 32; i <= 60; ++i) {
+    update = robot.step(0.1 * i);
+    EXPECT_FALSE(update.reset) << describe(update);
+    EXPECT_FALSE(update.fallback) << describe(update);
+    EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+  }
+  ASSERT_EQ(robot.warnings().size(), 1u) << robot.warnings().back();
+  EXPECT_NE(robot.warnings()[0].find("back"), std::string::npos) << robot.warnings()[0];
+  expectNear(update.pose, hglasm_test::relativeByHand(robot.truth(3.1), robot.truth(6.0)), 0.03, deg(0.5),
+             "since the reset");
+}
+
+// ------------------------------------------------------------------ wheel-odometry faults
+
+TEST(Robustness, LateOdometryFallsBackToConstantVelocityAndIsFlagged) {
+  // Odometry arrives 0.5 s late (a congested network): beyond odometry_max_extrapolation at every scan,
+  // so the tracker must say it predicted with the constant velocity, and still track.
+  TrackerOptions options;
+  options.odometry_max_extrapolation = 0.25;
+  Robot robot(options, circlePath);
+  robot.enableOdometry();
+  robot.setOdometryDelay(0.5);
+  TrackerUpdate update;
+  int constant_velocity = 0;
+  for (int i = 0; i <= 50; ++i) {
+    update = robot.step(0.1 * i);
+    if (i == 0) continue;
+    EXPECT_NE(update.prediction, PredictionSource::kOdometry) << describe(update);
+    if (update.prediction == PredictionSource::kConstantVelocity) ++constant_velocity;
+    EXPECT_FALSE(update.fallback) << describe(update);
+  }
+  EXPECT_GE(constant_velocity, 48);
+  expectNear(update.pose, robot.truth(5.0), 0.03, deg(0.5), "late odometry");
+  // A moderate delay (within max_extrapolation) is bridged by extrapolating the odometry itself.
+  Robot slightly_late(options, circlePath);
+  slightly_late.enableOdometry();
+  slightly_late.setOdometryDelay(0.1);
+  for (int i = 0; i <= 30; ++i) {
+    update = slightly_late.step(0.1 * i);
+    if (i > 1) {  // at 0.1 s no sample is old enough yet
+      EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+    }
+  }
+  expectNear(update.pose, slightly_late.truth(3.0), 0.03, deg(0.5), "slightly late odometry");
+}
+
+TEST(Robustness, OdometryJumpingTenMetresHasABoundedEffectAndIsFlagged) {
+  for (const Pose2D& jump : {Pose2D(10.0, 0.0, 0.0), Pose2D(0.0, -10.0, 0.0), Pose2D(7.0, 7.0, 2.0)}) {
+    SCOPED_TRACE("jump " + std::to_string(jump.x) + " " + std::to_string(jump.y) + " " +
+                 std::to_string(jump.theta));
+    Robot robot(TrackerOptions(), circlePath);
+    robot.enableOdometry(2.03, jump);  // the wheel-odometry frame is offset from 2.03 s on (a re-init)
+    TrackerUpdate update;
+    int flagged = 0;
+    for (int i = 0; i <= 50; ++i) {
+      update = robot.step(0.1 * i);
+      if (i == 0) continue;
+      EXPECT_FALSE(update.fallback) << describe(update);
+      if (i == 21) {  // the step over the jump: odometry implausible, constant velocity, one warning
+        EXPECT_EQ(update.prediction, PredictionSource::kConstantVelocity) << describe(update);
+        EXPECT_NE(update.warning.find("jumped"), std::string::npos) << describe(update);
+        ++flagged;
+      } else {
+        EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+      }
+      // Bounded: the estimate never leaves the true path.
+      expectNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
+    }
+    EXPECT_EQ(flagged, 1);
+    EXPECT_EQ(robot.warnings().size(), 1u);
+  }
+}
+
+TEST(Robustness, OdometrySpikeOfOneSampleHasABoundedEffect) {
+  // One corrupt wheel-odometry sample 10 m away (a glitch). Scans fall between samples, so the
+  // interpolated odometry carries a fraction of the spike: a large fraction is an implausible jump (constant
+  // velocity instead, warned), a small one a guess that is off by up to ~0.7 m, which the pre-alignment box
+  // of the medium preset (+-1 m) still covers.
+  for (double fraction : {0.5, 0.05}) {
+    SCOPED_TRACE("spike fraction " + std::to_string(fraction));
+    OdometryTracker tracker{TrackerOptions()};
+    const hglasm_test::World world = hglasm_test::room();
+    const LaserSpec laser = hglasm_test::halfCircleLaser();
+    int warnings = 0;
+    const double first_scan = 0.1 - 0.01 * (1.0 - fraction);
+    for (int i = 0; i <= 300; ++i) {  // odometry at 100 Hz; scans at 10 Hz between two samples
+      const double t = 0.01 * i;
+      Pose2D odom = circlePath(t);
+      if (i == 150) odom = hglasm_test::rawPose(odom.x + 10.0, odom.y, odom.theta);  // the spike
+      tracker.addOdometry(t, odom);
+      if (i % 10 != 0 || i == 0) continue;
+      // The scan `fraction` of a sample period before this sample: after the spike at 1.50 s the scan at
+      // 1.50 - 0.01 * (1 - fraction) s sees `fraction` of it.
+      const double stamp = t - 0.01 * (1.0 - fraction);
+      const TrackerUpdate update = tracker.processScan(
+          stamp, hglasm::scanFromRanges(hglasm_test::simulateRanges(world, circlePath(stamp), laser)));
+      expectSane(update);
+      if (!update.warning.empty()) ++warnings;
+      EXPECT_FALSE(update.fallback) << describe(update);
+      expectNear(update.pose, hglasm_test::relativeByHand(circlePath(first_scan), circlePath(stamp)), 0.03,
+                 deg(0.5), describe(update));
+    }
+    // The two steps touching the spike warn when it is implausible; a small fraction passes silently.
+    EXPECT_EQ(warnings, fraction > 0.1 ? 2 : 0);
+  }
+}
+
+// ------------------------------------------------------------------ degenerate geometry
+
+TEST(Robustness, FeaturelessCorridorIsUncertainAlongItAndDoesNotJump) {
+  // Driving along a long featureless corridor with a short-range laser, with and without wheel odometry.
+  const auto laser = hglasm_test::laserSpec(deg(270.0), 541, false, 8.0);
+  for (bool with_odometry : {true, false}) {
+    SCOPED_TRACE(with_odometry ? "with odometry" : "without odometry");
+    TrackerOptions options = with_odometry ? TrackerOptions() : withoutOdometry();
+    Robot robot(options, arcPath(0.5, 0.0), laser, hglasm_test::corridor(1.0, 200.0));
+    if (with_odometry) robot.enableOdometry();
+    TrackerUpdate update, previous;
+    for (int i = 0; i <= 60; ++i) {
+      previous = update;
+      update = robot.step(0.1 * i);
+      if (i == 0) continue;
+      // No jump: no step moves further than the robot could (0.05 m per scan) plus the GA's slack.
+      const Pose2D step = hglasm_test::relativeByHand(previous.pose, update.pose);
+      EXPECT_LT(std::hypot(step.x, step.y), 0.15) << describe(update);
+      EXPECT_LT(std::abs(step.theta), deg(2.0)) << describe(update);
+      // Across the corridor and in heading the scan determines the pose.
+      EXPECT_NEAR(update.pose.y, 0.0, 0.02) << describe(update);
+      EXPECT_NEAR(update.pose.theta, 0.0, deg(0.5)) << describe(update);
+      // The covariance knows that the corridor direction is unobserved.
+      EXPECT_GT(update.pose_covariance(0, 0), 10.0 * update.pose_covariance(1, 1)) << describe(update) << "\n"
+                                                                                   << update.pose_covariance;
+    }
+    if (with_odometry) {
+      // Along the corridor only the wheel odometry knows the motion: the estimate follows it.
+      EXPECT_NEAR(update.pose.x, 3.0, 0.1) << describe(update);
+    } else {
+      // Without odometry nothing observes the motion along the corridor; it must stay bounded.
+      EXPECT_LT(std::abs(update.pose.x), 6.0) << describe(update);
+    }
+  }
+}
+
+}  // namespace
