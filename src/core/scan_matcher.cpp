@@ -143,20 +143,25 @@ void ScanMatcher::setReference(const Scan& reference) {
   has_reference_ = reference_size_ > 0;
 }
 
-MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vector<Pose2D>* population_out) {
-  MatchResult result;
-  const Pose2D start_pose = guess.isFinite() ? guess : Pose2D();
-  result.pose = result.prealigned_pose = start_pose;
+bool ScanMatcher::startResult(const Scan& scan, const Pose2D& guess, MatchResult* result) const {
+  result->pose = result->prealigned_pose = guess.isFinite() ? guess : Pose2D();
   // Without a trustworthy estimate the covariance says so (finite, large).
-  result.covariance = Eigen::Matrix3d::Identity() * 1e4;
+  result->covariance = Eigen::Matrix3d::Identity() * 1e4;
   if (!has_reference_) {
-    result.status = MatchStatus::kNoReference;
-    return result;
+    result->status = MatchStatus::kNoReference;
+    return false;
   }
   if (scan.size() < 3) {
-    result.status = MatchStatus::kTooFewPoints;
-    return result;
+    result->status = MatchStatus::kTooFewPoints;
+    return false;
   }
+  return true;
+}
+
+MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vector<Pose2D>* population_out) {
+  MatchResult result;
+  if (!startResult(scan, guess, &result)) return result;
+  const Pose2D start_pose = result.pose;
 
   if (usesGeneticStage(options_.algorithm)) {
     const auto start = std::chrono::steady_clock::now();
@@ -203,16 +208,7 @@ void ScanMatcher::refineInto(const Scan& scan, MatchResult* result) {
 
 MatchResult ScanMatcher::refine(const Scan& scan, const Pose2D& guess) {
   MatchResult result;
-  result.pose = result.prealigned_pose = guess.isFinite() ? guess : Pose2D();
-  result.covariance = Eigen::Matrix3d::Identity() * 1e4;
-  if (!has_reference_) {
-    result.status = MatchStatus::kNoReference;
-    return result;
-  }
-  if (scan.size() < 3) {
-    result.status = MatchStatus::kTooFewPoints;
-    return result;
-  }
+  if (!startResult(scan, guess, &result)) return result;
   refineInto(scan, &result);
   result.fitness_ratio = fitnessRatioAt(scan, result.pose);
   return result;

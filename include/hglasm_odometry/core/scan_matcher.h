@@ -103,6 +103,8 @@ class ScanMatcher {
   LookupTable coarse_table_;
   GeneticAligner aligner_;
   Mbicp mbicp_;
+  /// Fills the defaults of a result (the guess, a large covariance); false if there is nothing to match.
+  bool startResult(const Scan& scan, const Pose2D& guess, MatchResult* result) const;
   void refineInto(const Scan& scan, MatchResult* result);
 
   bool has_reference_ = false;
