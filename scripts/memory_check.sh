@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Memory check over full replays (issue 5; too slow for CI, run by hand):
+# Memory check over full replays (issue 5; too slow for CI, run by hand, ~5 min):
 #   1. valgrind memcheck (leak-check=full) over `evaluate` on the whole fr079 bag (4934 scans): the same
 #      OdometryTracker pipeline as the nodelet, without ROS. Expect: no errors, nothing definitely or
 #      indirectly lost.
@@ -28,25 +28,24 @@ echo "logs in $out"
 status=0
 
 if [[ " $steps " == *" 1 "* ]]; then
-echo "== 1. valgrind memcheck: evaluate over fr079.orig.bag (takes ~2-3 min)"
-valgrind --tool=memcheck --leak-check=full --show-leak-kinds=definite,indirect,possible \
-  --errors-for-leak-kinds=definite,indirect --error-exitcode=3 --num-callers=30 \
-  --log-file="$out/valgrind_evaluate.log" \
-  "$bin/evaluate" --quiet --bag "$datasets/fr079/fr079.orig.bag" \
-  --relations "$datasets/fr079/fr079.relations" >"$out/evaluate_valgrind_stdout.txt" 2>&1
-rc=$?
-grep -E "ERROR SUMMARY|definitely lost|indirectly lost|possibly lost|still reachable|in use at exit" \
-  "$out/valgrind_evaluate.log" | sed 's/^==[0-9]*== /  /'
-grep SUMMARY "$out/evaluate_valgrind_stdout.txt" | sed 's/^/  /'
-if [ $rc -ne 0 ]; then echo "  FAIL: valgrind exit status $rc"; status=1; fi
+  echo "== 1. valgrind memcheck: evaluate over fr079.orig.bag (takes ~2-3 min)"
+  valgrind --tool=memcheck --leak-check=full --show-leak-kinds=definite,indirect,possible \
+    --errors-for-leak-kinds=definite,indirect --error-exitcode=3 --num-callers=30 \
+    --log-file="$out/valgrind_evaluate.log" \
+    "$bin/evaluate" --quiet --bag "$datasets/fr079/fr079.orig.bag" \
+    --relations "$datasets/fr079/fr079.relations" >"$out/evaluate_valgrind_stdout.txt" 2>&1
+  rc=$?
+  grep -E "ERROR SUMMARY|definitely lost|indirectly lost|possibly lost|still reachable|in use at exit" \
+    "$out/valgrind_evaluate.log" | sed 's/^==[0-9]*== /  /'
+  grep SUMMARY "$out/evaluate_valgrind_stdout.txt" | sed 's/^/  /'
+  if [ $rc -ne 0 ]; then echo "  FAIL: valgrind exit status $rc"; status=1; fi
 fi
 
 if [[ " $steps " == *" 2 "* ]]; then
-
-echo "== 2. peak RSS of evaluate over fr079.orig.bag (no valgrind)"
-/usr/bin/time -v "$bin/evaluate" --quiet --bag "$datasets/fr079/fr079.orig.bag" \
-  --relations "$datasets/fr079/fr079.relations" >"$out/evaluate_stdout.txt" 2>"$out/evaluate_time.txt"
-grep -E "Maximum resident|Elapsed" "$out/evaluate_time.txt" | sed 's/^\s*/  /'
+  echo "== 2. peak RSS of evaluate over fr079.orig.bag (no valgrind)"
+  /usr/bin/time -v "$bin/evaluate" --quiet --bag "$datasets/fr079/fr079.orig.bag" \
+    --relations "$datasets/fr079/fr079.relations" >"$out/evaluate_stdout.txt" 2>"$out/evaluate_time.txt"
+  grep -E "Maximum resident|Elapsed" "$out/evaluate_time.txt" | sed 's/^\s*/  /'
 fi
 
 [[ " $steps " == *" 3 "* ]] || exit $status
