@@ -151,12 +151,11 @@ PredictionSource OdometryTracker::predict(double stamp, Pose2D* predicted, std::
   return PredictionSource::kNone;
 }
 
-void OdometryTracker::setKeyframe(double stamp, const Scan& scan, const Pose2D& pose,
+void OdometryTracker::setKeyframe(const Scan& scan, const Pose2D& pose,
                                   const Eigen::Matrix3d& covariance) {
   matcher_.setReference(scan);
   has_keyframe_ = matcher_.hasReference();
   keyframe_requested_ = false;
-  keyframe_stamp_ = stamp;
   keyframe_pose_ = pose;
   keyframe_covariance_ = covariance;
   keyframe_beam_count_ = scan.beam_count;
@@ -198,7 +197,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
     update.pose = pose_;
     update.pose_covariance = pose_covariance_;
     if (usable) {
-      setKeyframe(stamp, scan, pose_, pose_covariance_);
+      setKeyframe(scan, pose_, pose_covariance_);
       update.new_keyframe = true;
       update.table_build_ms = matcher_.lastTableBuildMs();
     }
@@ -304,7 +303,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
                               std::abs(since_keyframe.theta) > options_.keyframe_angle ||
                               (update.matched && update.match.fitness_ratio < options_.keyframe_min_fitness);
   if (wants_keyframe && usable) {
-    setKeyframe(stamp, scan, pose_, pose_covariance_);
+    setKeyframe(scan, pose_, pose_covariance_);
     update.new_keyframe = true;
     update.table_build_ms = matcher_.lastTableBuildMs();
   }

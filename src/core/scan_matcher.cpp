@@ -139,8 +139,7 @@ void ScanMatcher::setReference(const Scan& reference) {
   }
   table_build_ms_ = millisecondsSince(start);
   mbicp_.setReference(reference);
-  reference_size_ = reference.size();
-  has_reference_ = reference_size_ > 0;
+  has_reference_ = !reference.empty();
 }
 
 bool ScanMatcher::startResult(const Scan& scan, const Pose2D& guess, MatchResult* result) const {

@@ -102,7 +102,7 @@ class OdometryTracker {
   PredictionSource predict(double stamp, Pose2D* predicted, std::string* warning) const;
   void guardAgainstJump(const Scan& scan, const Pose2D& laser_guess, PredictionSource prediction,
                         TrackerUpdate* update);
-  void setKeyframe(double stamp, const Scan& scan, const Pose2D& pose,
+  void setKeyframe(const Scan& scan, const Pose2D& pose,
                    const Eigen::Matrix3d& covariance);
 
   TrackerOptions options_;
@@ -123,7 +123,6 @@ class OdometryTracker {
   bool keyframe_requested_ = false;
   int keyframe_id_ = 0;
   int keyframe_beam_count_ = 0;
-  double keyframe_stamp_ = 0.0;
   Pose2D keyframe_pose_;
   Eigen::Matrix3d keyframe_covariance_ = Eigen::Matrix3d::Zero();
 };

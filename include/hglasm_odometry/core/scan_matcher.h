@@ -108,7 +108,6 @@ class ScanMatcher {
   void refineInto(const Scan& scan, MatchResult* result);
 
   bool has_reference_ = false;
-  std::size_t reference_size_ = 0;
   double table_build_ms_ = 0.0;
 };
 
