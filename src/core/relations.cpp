@@ -70,19 +70,32 @@ bool readRelations(const std::string& path, std::vector<Relation>* relations, st
 RelationStats evaluateRelations(const std::vector<Relation>& relations,
                                 const std::vector<StampedPose>& trajectory, double max_span,
                                 double stamp_tolerance) {
+  std::vector<Pose2D> estimated(relations.size());
+  std::vector<bool> valid(relations.size(), false);
+  for (std::size_t k = 0; k < relations.size(); ++k) {
+    const long i1 = findStamp(trajectory, relations[k].t1, stamp_tolerance);
+    const long i2 = findStamp(trajectory, relations[k].t2, stamp_tolerance);
+    if (i1 < 0 || i2 < 0) continue;
+    estimated[k] = relativePose(trajectory[i1].pose, trajectory[i2].pose);
+    valid[k] = true;
+  }
+  return evaluateRelativeMotions(relations, estimated, valid, max_span);
+}
+
+RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
+                                      const std::vector<Pose2D>& estimated, const std::vector<bool>& valid,
+                                      double max_span) {
   RelationStats stats;
   std::vector<double> trans_errors, rot_errors_deg;
-  for (const Relation& relation : relations) {
+  for (std::size_t k = 0; k < relations.size(); ++k) {
+    const Relation& relation = relations[k];
     if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
-    const long i1 = findStamp(trajectory, relation.t1, stamp_tolerance);
-    const long i2 = findStamp(trajectory, relation.t2, stamp_tolerance);
-    if (i1 < 0 || i2 < 0) {
+    if (k >= estimated.size() || k >= valid.size() || !valid[k]) {
       ++stats.missing;
       continue;
     }
-    const Pose2D estimated = relativePose(trajectory[i1].pose, trajectory[i2].pose);
     // Kümmerle's estimated ⊖ reference: the residual motion left once the reference is undone.
-    const Pose2D residual = relativePose(relation.motion, estimated);
+    const Pose2D residual = relativePose(relation.motion, estimated[k]);
     trans_errors.push_back(residual.translationNorm());
     rot_errors_deg.push_back(std::abs(normalizeAngle(residual.theta)) * kRadToDeg);
   }

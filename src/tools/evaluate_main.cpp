@@ -46,6 +46,9 @@ const char kUsage[] =
     "  --angle-increment A     override the scans' angle increment (radians)\n"
     "  --angle-min A           override the scans' first beam angle (radians)\n"
     "  --max-span S            short-relation span for the second metric row (default 10 s)\n"
+    "  --direct-pairs          also match each relation's own scan pair directly (MbICP started from the\n"
+    "                          reference motion): how closely any one-shot match of the very scans the\n"
+    "                          reference aligned can agree with it, the floor of the relations metric\n"
     "  --quiet                 no per-warning output\n";
 
 struct Arguments {
@@ -71,6 +74,7 @@ struct Arguments {
   bool override_angle_min = false;
   double angle_min = 0.0;
   double short_span = 10.0;
+  bool direct_pairs = false;
   bool quiet = false;
 };
 
@@ -124,6 +128,8 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
       args->use_odometry = false;
     } else if (flag == "--quiet") {
       args->quiet = true;
+    } else if (flag == "--direct-pairs") {
+      args->direct_pairs = true;
     } else if (flag == "--max-scans") {
       if (!number(&parsed) || parsed < 0) return false;
       args->max_scans = static_cast<std::size_t>(parsed);
@@ -433,9 +439,60 @@ void printRun(const Run& run, double data_seconds) {
               cpu_seconds > 0.0 ? data_seconds / cpu_seconds : 0.0);
 }
 
+/// The trajectory of the laser instead of the base: the reference relations come from aligning scans, so
+/// they may describe the laser's motion (for a laser at the base origin the two are the same).
+std::vector<hglasm::StampedPose> inLaserFrame(const std::vector<hglasm::StampedPose>& trajectory,
+                                              const hglasm::Pose2D& base_to_laser) {
+  std::vector<hglasm::StampedPose> laser;
+  laser.reserve(trajectory.size());
+  for (const auto& stamped : trajectory) laser.push_back({stamped.stamp, stamped.pose * base_to_laser});
+  return laser;
+}
+
+/// Each relation's scan pair matched on its own with MbICP, started from the reference motion (in the
+/// laser frame): base-frame motions per relation, valid where both stamps have a scan and MbICP
+/// converged. Not odometry: the reference is the start, so this shows how far the matcher's optimum of
+/// those very scans lies from the reference.
+void directPairs(const Arguments& args, const hglasm::TrackerOptions& options,
+                 const hglasm_odometry::BagData& data, const std::vector<hglasm::Relation>& relations,
+                 double max_span, std::vector<hglasm::Pose2D>* motions, std::vector<bool>* valid) {
+  hglasm::ScanConversionOptions conversion = options.conversion;
+  if (data.laser_upside_down) conversion.mirror = !conversion.mirror;
+  const hglasm::Pose2D mount = data.has_laser_mount ? data.base_to_laser : hglasm::Pose2D();
+  const auto scan_at = [&](double stamp) -> const hglasm_odometry::BagScan* {
+    const auto it = std::lower_bound(
+        data.scans.begin(), data.scans.end(), stamp - 1e-3,
+        [](const hglasm_odometry::BagScan& scan, double value) { return scan.stamp < value; });
+    return it != data.scans.end() && std::abs(it->stamp - stamp) <= 1e-3 ? &*it : nullptr;
+  };
+  const auto convert = [&](const hglasm_odometry::BagScan& bag_scan) {
+    hglasm::RangeScan ranges = bag_scan.ranges;  // the same overrides as the tracker's run
+    if (args.override_increment) ranges.angle_increment = args.angle_increment;
+    if (args.override_angle_min) ranges.angle_min = args.angle_min;
+    return hglasm::scanFromRanges(ranges, conversion);
+  };
+  hglasm::ScanMatcher matcher(options.matcher);
+  motions->assign(relations.size(), hglasm::Pose2D());
+  valid->assign(relations.size(), false);
+  for (std::size_t k = 0; k < relations.size(); ++k) {
+    const hglasm::Relation& relation = relations[k];
+    if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
+    const hglasm_odometry::BagScan* first = scan_at(relation.t1);
+    const hglasm_odometry::BagScan* second = scan_at(relation.t2);
+    if (!first || !second) continue;
+    matcher.setReference(convert(*first));
+    const hglasm::Pose2D start = mount.inverse() * relation.motion * mount;
+    const hglasm::MatchResult result = matcher.refine(convert(*second), start);
+    if (result.status != hglasm::MatchStatus::kOk) continue;
+    (*motions)[k] = mount * result.pose * mount.inverse();
+    (*valid)[k] = true;
+  }
+}
+
 void printRelations(const Arguments& args, const std::string& preset_name, const Run& run,
                     const std::vector<hglasm::Relation>& relations,
-                    const std::vector<hglasm::StampedPose>& wheel_trajectory) {
+                    const std::vector<hglasm::StampedPose>& wheel_trajectory,
+                    const hglasm::TrackerOptions& options, const hglasm_odometry::BagData& data) {
   const bool has_wheel = !wheel_trajectory.empty();
   std::printf("\nrelations     %s: %zu (Kümmerle et al. 2009; mean +- std, population)\n",
               args.relations.c_str(), relations.size());
@@ -447,20 +504,47 @@ void printRelations(const Arguments& args, const std::string& preset_name, const
   std::snprintf(short_label, sizeof(short_label), "<= %g s", args.short_span);
   std::printf("  %-9s %5s %7s | %-33s", "relations", "n", "missing", "laser odometry: m, deg");
   if (has_wheel) std::printf(" | %s", "wheel odometry: m, deg");
-  std::printf("\n");
+  std::printf("\n  base frame ('%s', the trajectory's)\n", data.base_frame.c_str());
   printStatsRows("all", laser_all, wheel_all, has_wheel);
   printStatsRows(short_label, laser_short, wheel_short, has_wheel);
+
+  const bool laser_offset = data.has_laser_mount && !(data.base_to_laser.translationNorm() < 1e-9 &&
+                                                      std::abs(data.base_to_laser.theta) < 1e-9);
+  hglasm::RelationStats laser_frame_short = laser_short;
+  if (laser_offset) {
+    const auto laser_trajectory = inLaserFrame(run.trajectory, data.base_to_laser);
+    const auto wheel_laser = inLaserFrame(wheel_trajectory, data.base_to_laser);
+    laser_frame_short = hglasm::evaluateRelations(relations, laser_trajectory, args.short_span);
+    std::printf(
+        "  laser frame (the same trajectories moved to the laser, if the reference describes its motion)\n");
+    printStatsRows("all", hglasm::evaluateRelations(relations, laser_trajectory, 0.0),
+                   hglasm::evaluateRelations(relations, wheel_laser, 0.0), has_wheel);
+    printStatsRows(short_label, laser_frame_short,
+                   hglasm::evaluateRelations(relations, wheel_laser, args.short_span), has_wheel);
+  }
+  if (args.direct_pairs) {
+    std::vector<hglasm::Pose2D> motions;
+    std::vector<bool> valid;
+    directPairs(args, options, data, relations, args.short_span, &motions, &valid);
+    const auto direct = hglasm::evaluateRelativeMotions(relations, motions, valid, args.short_span);
+    std::printf(
+        "  direct pairs: each relation's scans matched on their own from the reference motion, base frame\n");
+    std::printf("  %-9s %5d %7d | %.4f +- %.4f  %6.3f +- %6.3f  (missing: no scan or no converged match)\n",
+                short_label, direct.count, direct.missing, direct.trans_mean, direct.trans_std,
+                direct.rot_mean_deg, direct.rot_std_deg);
+  }
   // One machine-readable line for scripts/evaluate_all.sh.
   const Spread total = spreadOf(run.total_ms);
   const std::size_t scans = run.processed;
   std::printf(
       "SUMMARY preset=%s scans=%zu fallbacks=%d fallback_pct=%.3f cpu_median_ms=%.3f cpu_p99_ms=%.3f "
       "cpu_max_ms=%.3f all_t=%.4f all_r=%.3f short_t=%.4f short_r=%.3f wheel_all_t=%.4f "
-      "wheel_all_r=%.3f wheel_short_t=%.4f wheel_short_r=%.3f\n",
+      "wheel_all_r=%.3f wheel_short_t=%.4f wheel_short_r=%.3f laser_frame_short_t=%.4f "
+      "laser_frame_short_r=%.3f\n",
       preset_name.c_str(), scans, run.fallbacks, scans ? 100.0 * run.fallbacks / scans : 0.0, total.median,
       total.p99, total.max, laser_all.trans_mean, laser_all.rot_mean_deg, laser_short.trans_mean,
       laser_short.rot_mean_deg, wheel_all.trans_mean, wheel_all.rot_mean_deg, wheel_short.trans_mean,
-      wheel_short.rot_mean_deg);
+      wheel_short.rot_mean_deg, laser_frame_short.trans_mean, laser_frame_short.rot_mean_deg);
 }
 
 }  // namespace
@@ -524,7 +608,8 @@ int main(int argc, char** argv) {
     hglasm::Pose2D pose;
     if (wheelPoseAt(data.odometry, bag_scan.stamp, &pose)) wheel_trajectory.push_back({bag_scan.stamp, pose});
   }
-  if (!relations.empty()) printRelations(args, nodelet_options.preset, run, relations, wheel_trajectory);
+  if (!relations.empty())
+    printRelations(args, nodelet_options.preset, run, relations, wheel_trajectory, options, data);
 
   if (!args.out.empty()) {
     if (!writeTrajectory(args.out, run.trajectory)) {

@@ -207,5 +207,22 @@ TEST(Relations, ReadsTheBenchmarkFiles) {
   }
 }
 
+TEST(Relations, PairwiseMotionsUseTheSameMetric) {
+  // Motions estimated pair by pair: the metric is the one of a trajectory holding the same motions.
+  const std::vector<Relation> relations = {{0.0, 1.0, Pose2D(1.0, 0.0, 0.1)},
+                                           {1.0, 2.0, Pose2D(0.5, 0.2, -0.2)},
+                                           {2.0, 30.0, Pose2D(2.0, 0.0, 0.0)}};
+  const std::vector<Pose2D> estimated = {Pose2D(1.05, 0.0, 0.1), Pose2D(0.5, 0.2, -0.15), Pose2D()};
+  const std::vector<bool> valid = {true, true, false};
+  const RelationStats stats = evaluateRelativeMotions(relations, estimated, valid, 10.0);
+  EXPECT_EQ(stats.count, 2);
+  EXPECT_EQ(stats.missing, 0);  // the invalid one spans 28 s: outside max_span, not missing
+  EXPECT_NEAR(stats.trans_mean, 0.025, 1e-9);
+  EXPECT_NEAR(stats.rot_mean_deg, 0.025 * kRadToDeg, 1e-9);
+  const RelationStats all = evaluateRelativeMotions(relations, estimated, valid, 0.0);
+  EXPECT_EQ(all.count, 2);
+  EXPECT_EQ(all.missing, 1);
+}
+
 }  // namespace
 }  // namespace hglasm

@@ -19,11 +19,11 @@ struct Relation {
 bool readRelations(const std::string& path, std::vector<Relation>* relations, std::string* error);
 
 struct RelationStats {
-  int count = 0;             ///< relations evaluated
-  int missing = 0;           ///< relations whose stamps are not in the trajectory
-  double trans_mean = 0.0;   ///< metres
+  int count = 0;            ///< relations evaluated
+  int missing = 0;          ///< relations whose stamps are not in the trajectory
+  double trans_mean = 0.0;  ///< metres
   double trans_std = 0.0;
-  double rot_mean_deg = 0.0; ///< absolute rotational error, degrees
+  double rot_mean_deg = 0.0;  ///< absolute rotational error, degrees
   double rot_std_deg = 0.0;
   double trans_sq_mean = 0.0;    ///< m^2
   double rot_sq_mean_deg = 0.0;  ///< deg^2
@@ -35,5 +35,11 @@ struct RelationStats {
 RelationStats evaluateRelations(const std::vector<Relation>& relations,
                                 const std::vector<StampedPose>& trajectory, double max_span,
                                 double stamp_tolerance = 1e-3);
+
+/// The same metric for relative motions estimated relation by relation: estimated[k] is the motion from
+/// t1 to t2 of relations[k], used if valid[k] (else the relation counts as missing).
+RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
+                                      const std::vector<Pose2D>& estimated, const std::vector<bool>& valid,
+                                      double max_span);
 
 }  // namespace hglasm
