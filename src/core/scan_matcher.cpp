@@ -106,7 +106,11 @@ MatcherOptions presetOptions(Preset preset) {
       options.genetic.population = 200;
       options.genetic.generations = 12;
       options.genetic.runs = 2;
-      options.genetic.coarse_generations = 4;
+      // The +-pi box: a wider, coarser first stage (sigma 0.6 m on 12 cm cells) for half the generations
+      // finds the true basin instead of a 180-degree look-alike more often (intel, whole box, 5 seeds of
+      // 500 trials: 97.1 -> 98.6 %).
+      options.genetic.coarse_generations = 6;
+      options.coarse_table = LookupTableOptions{TableKind::kGraded, 0.12, 0.60, 1.20, 0.30, 0.10};
       break;
   }
   return options;
