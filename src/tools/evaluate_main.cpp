@@ -353,6 +353,22 @@ struct Run {
   std::vector<double> total_ms, convert_ms, prealign_ms, refine_ms, table_ms;
 };
 
+/// The tracker's scan conversion for this bag: an upside-down laser's scans are mirrored.
+hglasm::ScanConversionOptions conversionFor(const hglasm::TrackerOptions& options,
+                                            const hglasm_odometry::BagData& data) {
+  hglasm::ScanConversionOptions conversion = options.conversion;
+  if (data.laser_upside_down) conversion.mirror = !conversion.mirror;
+  return conversion;
+}
+
+/// A bag scan's ranges with the command line's beam-angle overrides.
+hglasm::RangeScan rangesOf(const Arguments& args, const hglasm_odometry::BagScan& bag_scan) {
+  hglasm::RangeScan ranges = bag_scan.ranges;
+  if (args.override_increment) ranges.angle_increment = args.angle_increment;
+  if (args.override_angle_min) ranges.angle_min = args.angle_min;
+  return ranges;
+}
+
 /// Feeds the bag to the tracker exactly as the nodelet would: odometry stamped up to each scan first,
 /// then the scan (converted with the tracker's options, mirrored for an upside-down laser).
 Run runTracker(const Arguments& args, const hglasm::TrackerOptions& options,
@@ -360,8 +376,7 @@ Run runTracker(const Arguments& args, const hglasm::TrackerOptions& options,
   Run run;
   hglasm::OdometryTracker tracker(options);
   if (data.has_laser_mount) tracker.setLaserMount(data.base_to_laser);
-  hglasm::ScanConversionOptions conversion = options.conversion;
-  if (data.laser_upside_down) conversion.mirror = !conversion.mirror;
+  const hglasm::ScanConversionOptions conversion = conversionFor(options, data);
 
   std::size_t next_odometry = 0;
   double last_processed_stamp = -std::numeric_limits<double>::infinity();
@@ -378,9 +393,7 @@ Run runTracker(const Arguments& args, const hglasm::TrackerOptions& options,
         tracker.addOdometry(data.odometry[next_odometry].stamp, data.odometry[next_odometry].pose);
       }
     }
-    hglasm::RangeScan ranges = bag_scan.ranges;
-    if (args.override_increment) ranges.angle_increment = args.angle_increment;
-    if (args.override_angle_min) ranges.angle_min = args.angle_min;
+    const hglasm::RangeScan ranges = rangesOf(args, bag_scan);
 
     const double start = cpuMs();
     hglasm::ScanError scan_error = hglasm::ScanError::kNone;
@@ -456,8 +469,7 @@ std::vector<hglasm::StampedPose> inLaserFrame(const std::vector<hglasm::StampedP
 void directPairs(const Arguments& args, const hglasm::TrackerOptions& options,
                  const hglasm_odometry::BagData& data, const std::vector<hglasm::Relation>& relations,
                  double max_span, std::vector<hglasm::Pose2D>* motions, std::vector<bool>* valid) {
-  hglasm::ScanConversionOptions conversion = options.conversion;
-  if (data.laser_upside_down) conversion.mirror = !conversion.mirror;
+  const hglasm::ScanConversionOptions conversion = conversionFor(options, data);
   const hglasm::Pose2D mount = data.has_laser_mount ? data.base_to_laser : hglasm::Pose2D();
   const auto scan_at = [&](double stamp) -> const hglasm_odometry::BagScan* {
     const auto it = std::lower_bound(
@@ -466,10 +478,7 @@ void directPairs(const Arguments& args, const hglasm::TrackerOptions& options,
     return it != data.scans.end() && std::abs(it->stamp - stamp) <= 1e-3 ? &*it : nullptr;
   };
   const auto convert = [&](const hglasm_odometry::BagScan& bag_scan) {
-    hglasm::RangeScan ranges = bag_scan.ranges;  // the same overrides as the tracker's run
-    if (args.override_increment) ranges.angle_increment = args.angle_increment;
-    if (args.override_angle_min) ranges.angle_min = args.angle_min;
-    return hglasm::scanFromRanges(ranges, conversion);
+    return hglasm::scanFromRanges(rangesOf(args, bag_scan), conversion);
   };
   hglasm::ScanMatcher matcher(options.matcher);
   motions->assign(relations.size(), hglasm::Pose2D());
