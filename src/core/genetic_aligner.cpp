@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace hglasm {
 namespace {
@@ -20,7 +21,8 @@ class Codec {
     scale_[0] = 2.0 * box.half_x / levels;
     scale_[1] = 2.0 * box.half_y / levels;
     // A full-turn box would put -pi and +pi on two distinct genes: spread the levels over [-pi, pi).
-    const double theta_span = box.half_theta >= M_PI ? 2.0 * M_PI * levels / (levels + 1.0) : 2.0 * box.half_theta;
+    const double theta_span =
+        box.half_theta >= M_PI ? 2.0 * M_PI * levels / (levels + 1.0) : 2.0 * box.half_theta;
     scale_[2] = theta_span / levels;
     low_[0] = -box.half_x;
     low_[1] = -box.half_y;
@@ -52,6 +54,29 @@ struct Individual {
   std::uint32_t fitness = 0;
 };
 
+/// Latin hypercube: each gene's range is cut into one slice per individual and every slice is used once,
+/// so the first generation covers every heading of a +-pi box (uniform draws leave gaps that the GA then
+/// has to close by mutation, and a 180-degree look-alike wins more often).
+void seedLatinHypercube(int bits, std::mt19937_64& rng, std::vector<int>* slices,
+                        std::vector<Individual>* population) {
+  const std::uint64_t gene_levels = std::uint64_t{1} << bits;
+  const std::size_t size = population->size();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (auto& individual : *population) individual.chromosome = 0;
+  slices->resize(size);
+  for (int gene = 0; gene < 3; ++gene) {
+    std::iota(slices->begin(), slices->end(), 0);
+    std::shuffle(slices->begin(), slices->end(), rng);
+    for (std::size_t i = 0; i < size; ++i) {
+      const double position = (static_cast<double>((*slices)[i]) + unit(rng)) / static_cast<double>(size);
+      const std::uint64_t level =
+          std::min(gene_levels - 1, static_cast<std::uint64_t>(position * static_cast<double>(gene_levels)));
+      const std::uint64_t gray = level ^ (level >> 1);
+      (*population)[i].chromosome |= gray << ((2 - gene) * bits);
+    }
+  }
+}
+
 }  // namespace
 
 GeneticAligner::GeneticAligner(const GeneticOptions& options) : options_(options), rng_(options.seed) {
@@ -68,7 +93,8 @@ GeneticAligner::GeneticAligner(const GeneticOptions& options) : options_(options
 PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector<Eigen::Vector2d>& all_points,
                                      const Pose2D& guess, std::vector<Pose2D>* population_out,
                                      const LookupTable* coarse_table) {
-  const std::size_t limit = options_.max_points > 0 ? static_cast<std::size_t>(options_.max_points) : all_points.size();
+  const std::size_t limit =
+      options_.max_points > 0 ? static_cast<std::size_t>(options_.max_points) : all_points.size();
   const std::vector<Eigen::Vector2d>* selected = &all_points;
   if (all_points.size() > limit) {
     subset_.clear();
@@ -85,14 +111,13 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
 
   const Codec codec(options_.box, guess, options_.bits_per_gene);
   const int total_bits = codec.totalBits();
-  const std::uint64_t all_bits = (std::uint64_t{1} << total_bits) - 1;
   const int population_size = options_.population;
-  std::uniform_int_distribution<std::uint64_t> random_chromosome(0, all_bits);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::uniform_int_distribution<int> random_member(0, population_size - 1);
   std::uniform_int_distribution<int> random_cut(1, total_bits - 1);
 
   std::vector<Individual> population(population_size), offspring(population_size);
+  std::vector<int> slices;
   const int elite_count = std::clamp(options_.elite_count, 1, population_size - 1);
   const int coarse_generations = coarse_table && !coarse_table->empty() ? options_.coarse_generations : 0;
   const LookupTable* scoring = &table;
@@ -126,10 +151,8 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
   std::uint32_t best_run_fitness = 0;
   for (int run = 0; run < options_.runs; ++run) {
     scoring = coarse_generations > 0 ? coarse_table : &table;
-    for (auto& individual : population) {
-      individual.chromosome = random_chromosome(rng_);
-      evaluate(individual);
-    }
+    seedLatinHypercube(options_.bits_per_gene, rng_, &slices, &population);
+    for (auto& individual : population) evaluate(individual);
     for (int generation = 1; generation < options_.generations; ++generation) {
       if (generation == coarse_generations) {
         scoring = &table;  // switch to the fine table: rescore the survivors on it
@@ -158,8 +181,9 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
       }
       population.swap(offspring);
     }
-    const auto best = std::max_element(population.begin(), population.end(),
-                                       [](const Individual& a, const Individual& b) { return a.fitness < b.fitness; });
+    const auto best =
+        std::max_element(population.begin(), population.end(),
+                         [](const Individual& a, const Individual& b) { return a.fitness < b.fitness; });
     if (best->fitness > result.fitness) {
       result.fitness = best->fitness;
       result.pose = codec.decode(best->chromosome);
@@ -174,7 +198,8 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
 
   if (population_out) {
     population_out->clear();
-    for (const auto& individual : best_run_population) population_out->push_back(codec.decode(individual.chromosome));
+    for (const auto& individual : best_run_population)
+      population_out->push_back(codec.decode(individual.chromosome));
   }
   const double max_fitness = static_cast<double>(table.maxCellValue()) * static_cast<double>(points.size());
   result.fitness_ratio = max_fitness > 0.0 ? result.fitness / max_fitness : 0.0;
@@ -185,7 +210,8 @@ void GeneticAligner::polish(const LookupTable& table, const FitnessPoints& point
                             PreAlignResult* result) const {
   // Candidates stay inside the search box around the guess, like every GA individual.
   const auto inside_box = [&](const Pose2D& pose) {
-    return std::abs(pose.x - guess.x) <= options_.box.half_x && std::abs(pose.y - guess.y) <= options_.box.half_y &&
+    return std::abs(pose.x - guess.x) <= options_.box.half_x &&
+           std::abs(pose.y - guess.y) <= options_.box.half_y &&
            std::abs(normalizeAngle(pose.theta - guess.theta)) <= options_.box.half_theta;
   };
   // Compass search: try +-step on each axis, move to the first improvement, halve the steps when none.

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <array>
 #include <cmath>
 #include <iostream>
@@ -244,6 +246,43 @@ TEST(GeneticAligner, PopulationStaysInTheBoxAroundTheGuess) {
     aligner.align(room.table(), scan.points, guess, &population);
     ASSERT_EQ(population.size(), static_cast<std::size_t>(options.population));
     for (const Pose2D& pose : population) EXPECT_EQ(outsideBox(pose, guess, options.box), "");
+  }
+}
+
+TEST(GeneticAligner, FirstGenerationIsALatinHypercubeOfTheBox) {
+  // One generation: the population returned is the initial one. Cut each gene's range (2^bits levels, the
+  // box end to end) into one slice per individual: each slice holds one individual, so the i-th smallest
+  // level of every gene lies in slice i (the levels at a slice's edges belong to both neighbours).
+  const RoomFixture room(hglasm_test::halfCircleLaser());
+  const auto scan = room.scanAt(Pose2D(0.1, 0.0, 0.0));
+  GeneticOptions options;
+  options.box = {0.8, 0.5, 0.6};
+  options.population = 40;
+  options.generations = 1;
+  options.runs = 1;
+  options.polish_evaluations = 0;
+  const Pose2D guess(0.3, -0.2, 0.1);
+  GeneticAligner aligner(options);
+  std::vector<Pose2D> population;
+  aligner.align(room.table(), scan.points, guess, &population);
+  ASSERT_EQ(population.size(), static_cast<std::size_t>(options.population));
+  const double half_widths[3] = {options.box.half_x, options.box.half_y, options.box.half_theta};
+  const long levels = 1L << options.bits_per_gene;
+  const long size = options.population;
+  for (int gene = 0; gene < 3; ++gene) {
+    std::vector<long> gene_levels;
+    for (const Pose2D& pose : population) {
+      const double offset = gene == 0   ? pose.x - guess.x
+                            : gene == 1 ? pose.y - guess.y
+                                        : pose.theta - guess.theta;
+      gene_levels.push_back(
+          std::lround((offset + half_widths[gene]) / (2.0 * half_widths[gene]) * (levels - 1)));
+    }
+    std::sort(gene_levels.begin(), gene_levels.end());
+    for (long i = 0; i < size; ++i) {
+      EXPECT_GE(gene_levels[i], i * levels / size) << "gene " << gene << ", slice " << i;
+      EXPECT_LE(gene_levels[i], (i + 1) * levels / size) << "gene " << gene << ", slice " << i;
+    }
   }
 }
 

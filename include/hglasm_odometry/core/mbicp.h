@@ -23,7 +23,7 @@ struct MbicpOptions {
   /// segment_max_gap + segment_gap_per_metre * range (beams diverge with range).
   double segment_max_gap = 0.30;      ///< metres
   double segment_gap_per_metre = 0.10;
-  double trim_fraction = 0.95;        ///< keep this fraction of the best associations
+  double trim_fraction = 0.95;  ///< keep this fraction of the best associations
   int max_iterations = 50;
   double error_ratio = 1e-4;          ///< |E_k - E_k-1| / E_k below this counts as no progress
   double min_step_xy = 1e-4;          ///< metres: a step smaller than this counts as no progress
@@ -31,9 +31,10 @@ struct MbicpOptions {
   int converged_iterations = 2;       ///< consecutive no-progress iterations to stop
   double min_association_ratio = 0.1; ///< fail below this fraction of the new scan associated
   double degenerate_eigenvalue = 1e-6;  ///< relative: min/max eigenvalue of the normal equations
-  /// M-step residual of a point associated with a reference segment: true = its d_ap distance to the
-  /// segment's line (the metric restricted to the normal; converges in a few iterations like PL-ICP),
-  /// false = its d_ap distance to the closest point, as in the original MbICP (slower, linear convergence).
+  /// M-step residual of a point associated with a reference segment or a segment's end point: true = its
+  /// d_ap distance to the segment's line (the metric restricted to the normal; converges in a few iterations
+  /// like PL-ICP), false = its d_ap distance to the closest point, as in the original MbICP (slower, linear
+  /// convergence). Isolated reference points are always point-to-point.
   bool point_to_line = true;
 };
 
@@ -71,8 +72,7 @@ class Mbicp {
   struct Association {
     Eigen::Vector2d point;   // new point in the reference frame (current estimate)
     Eigen::Vector2d target;  // closest point on the reference (point or segment)
-    Eigen::Vector2d normal;  // reference surface normal there (zero if unknown)
-    bool on_segment;         // target lies inside a reference segment (normal = the segment's)
+    Eigen::Vector2d normal;  // reference surface normal there (zero for an isolated point)
     double distance_sq;      // d_ap^2
   };
   void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) const;
