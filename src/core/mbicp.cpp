@@ -103,6 +103,7 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, st
         best = d_sq, found = true;
         association.target = ref_points_[j];
         association.normal = ref_normals_[j];
+        association.on_segment = false;
       }
     };
     auto consider_segment = [&](int j) {
@@ -120,6 +121,7 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, st
         best = d_sq, found = true;
         association.target = on_segment;
         association.normal = unitNormal(e);
+        association.on_segment = true;
       }
     };
 
@@ -232,10 +234,12 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
       const Eigen::Vector2d& c = assoc.target;
       const Eigen::Vector2d u(c.y(), -c.x());
       Eigen::Matrix2d m = Eigen::Matrix2d::Identity() - u * u.transpose() / (c.squaredNorm() + l_sq);
-      if (options_.point_to_line && !assoc.normal.isZero()) {
-        // Distance to the line under the metric: remove the metric-weighted tangent direction. A point just
-        // past a segment's end point goes to that end point's line too: point-to-point there would pull it
-        // along the surface, towards the last reference beam, a rotation bias at every edge.
+      // A point just past a segment's end point: point-to-point while the estimate moves (its pull along
+      // the surface helps turn a scan in from afar), then onto that end point's line (point-to-point would
+      // pull it towards the last reference beam: a rotation bias at every edge).
+      const bool line_residual = assoc.on_segment || (settled && !assoc.normal.isZero());
+      if (options_.point_to_line && line_residual) {
+        // Distance to the line under the metric: remove the metric-weighted tangent direction.
         const Eigen::Vector2d tangent(assoc.normal.y(), -assoc.normal.x());
         const Eigen::Vector2d m_tangent = m * tangent;
         m -= m_tangent * m_tangent.transpose() / tangent.dot(m_tangent);

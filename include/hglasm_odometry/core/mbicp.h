@@ -31,10 +31,10 @@ struct MbicpOptions {
   int converged_iterations = 2;       ///< consecutive no-progress iterations to stop
   double min_association_ratio = 0.1; ///< fail below this fraction of the new scan associated
   double degenerate_eigenvalue = 1e-6;  ///< relative: min/max eigenvalue of the normal equations
-  /// M-step residual of a point associated with a reference segment or a segment's end point: true = its
-  /// d_ap distance to the segment's line (the metric restricted to the normal; converges in a few iterations
-  /// like PL-ICP), false = its d_ap distance to the closest point, as in the original MbICP (slower, linear
-  /// convergence). Isolated reference points are always point-to-point.
+  /// M-step residual of a point associated with a reference segment (or, once settled, a segment's end
+  /// point): true = its d_ap distance to the segment's line (the metric restricted to the normal; converges
+  /// in a few iterations like PL-ICP), false = its d_ap distance to the closest point, as in the original
+  /// MbICP (slower, linear convergence). Isolated reference points are always point-to-point.
   bool point_to_line = true;
 };
 
@@ -73,6 +73,7 @@ class Mbicp {
     Eigen::Vector2d point;   // new point in the reference frame (current estimate)
     Eigen::Vector2d target;  // closest point on the reference (point or segment)
     Eigen::Vector2d normal;  // reference surface normal there (zero for an isolated point)
+    bool on_segment;         // target lies inside a reference segment (normal = the segment's)
     double distance_sq;      // d_ap^2
   };
   void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) const;
