@@ -199,6 +199,8 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
   int quiet_iterations = 0;
   const double fine_gate = options_.fine_max_distance > 0.0 ? options_.fine_max_distance : options_.max_distance;
   bool settled = fine_gate == options_.max_distance;
+  Pose2D previous_pose, two_poses_ago;  // estimates of the last two settled iterations
+  int settled_poses = 0;
   result.status = MbicpStatus::kMaxIterations;
   moved_.resize(points.size());
 
@@ -271,11 +273,20 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
       previous_error = -1.0;
       continue;
     }
-    const bool small_step = std::abs(step.x()) < options_.min_step_xy && std::abs(step.y()) < options_.min_step_xy &&
-                            std::abs(step.z()) < options_.min_step_theta;
+    const auto within_min_step = [&](const Pose2D& delta) {
+      return std::abs(delta.x) < options_.min_step_xy && std::abs(delta.y) < options_.min_step_xy &&
+             std::abs(delta.theta) < options_.min_step_theta;
+    };
+    const bool small_step = within_min_step(Pose2D(step.x(), step.y(), step.z()));
     const bool no_progress =
         previous_error >= 0.0 && std::abs(previous_error - error) <= options_.error_ratio * std::max(error, 1e-12);
-    quiet_iterations = (small_step || no_progress) ? quiet_iterations + 1 : 0;
+    // Back where it was two iterations ago: the associations flip between two sets (a point at the gate's
+    // edge, or between an end point's line and a neighbouring segment) and neither step makes progress.
+    const bool cycling = settled_poses >= 2 && within_min_step(result.pose * two_poses_ago.inverse());
+    two_poses_ago = previous_pose;
+    previous_pose = result.pose;
+    ++settled_poses;
+    quiet_iterations = (small_step || no_progress || cycling) ? quiet_iterations + 1 : 0;
     previous_error = error;
     if (quiet_iterations >= options_.converged_iterations) {
       result.status = MbicpStatus::kConverged;
