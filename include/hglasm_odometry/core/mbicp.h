@@ -23,7 +23,7 @@ struct MbicpOptions {
   /// segment_max_gap + segment_gap_per_metre * range (beams diverge with range).
   double segment_max_gap = 0.30;      ///< metres
   double segment_gap_per_metre = 0.10;
-  double trim_fraction = 0.95;  ///< keep this fraction of the best associations
+  double trim_fraction = 0.95;        ///< keep this fraction of the best associations
   int max_iterations = 50;
   double error_ratio = 1e-4;          ///< |E_k - E_k-1| / E_k below this counts as no progress
   double min_step_xy = 1e-4;          ///< metres: a step smaller than this counts as no progress
