@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 
+#include "test_expect.h"
 #include "test_util.h"
 
 namespace {
@@ -154,10 +155,7 @@ TEST(OdometryTracker, FollowsACircleWithoutWheelOdometry) {
   EXPECT_EQ(fallbacks, 0);
   EXPECT_GT(keyframes, 10);
   EXPECT_EQ(last.prediction, PredictionSource::kConstantVelocity);
-  EXPECT_LT(hglasm_test::translationError(last.pose, truth), 0.05)
-      << "final " << last.pose.x << " " << last.pose.y << " " << last.pose.theta << " vs " << truth.x << " "
-      << truth.y << " " << truth.theta;
-  EXPECT_LT(hglasm_test::rotationError(last.pose, truth), hglasm_test::deg(0.5));
+  hglasm_test::expectPoseNear(last.pose, truth, 0.05, hglasm_test::deg(0.5), "final pose");
   // The velocity is the path's: 0.5 m/s forward, turning right at 1/3 rad/s.
   EXPECT_NEAR(last.velocity.x(), 0.5, 0.05);
   EXPECT_NEAR(last.velocity.y(), 0.0, 0.05);
@@ -172,10 +170,7 @@ TEST(OdometryTracker, FollowsACircleWithDriftingWheelOdometry) {
   const Pose2D truth = robot.truth(25.0);
   EXPECT_EQ(fallbacks, 0);
   EXPECT_EQ(last.prediction, PredictionSource::kOdometry);
-  EXPECT_LT(hglasm_test::translationError(last.pose, truth), 0.05)
-      << "final " << last.pose.x << " " << last.pose.y << " " << last.pose.theta << " vs " << truth.x << " "
-      << truth.y << " " << truth.theta;
-  EXPECT_LT(hglasm_test::rotationError(last.pose, truth), hglasm_test::deg(0.5));
+  hglasm_test::expectPoseNear(last.pose, truth, 0.05, hglasm_test::deg(0.5), "final pose");
   // The wheel odometry alone is far off: the laser did the work.
   EXPECT_GT(hglasm_test::translationError(robot.odometryPose(), truth), 0.3);
 }
@@ -187,10 +182,7 @@ TEST(OdometryTracker, LaserMountIsAccountedFor) {
   const TrackerUpdate last = drive(&robot, 10.0, &fallbacks, &keyframes);
   const Pose2D truth = robot.truth(10.0);  // the base, not the laser
   EXPECT_EQ(fallbacks, 0);
-  EXPECT_LT(hglasm_test::translationError(last.pose, truth), 0.03)
-      << "final " << last.pose.x << " " << last.pose.y << " " << last.pose.theta << " vs " << truth.x << " "
-      << truth.y << " " << truth.theta;
-  EXPECT_LT(hglasm_test::rotationError(last.pose, truth), hglasm_test::deg(0.5));
+  hglasm_test::expectPoseNear(last.pose, truth, 0.03, hglasm_test::deg(0.5), "final pose");
 }
 
 TEST(OdometryTracker, KeyframesFollowKeyframeDistance) {

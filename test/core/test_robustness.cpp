@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "test_expect.h"
 #include "test_util.h"
 
 namespace {
@@ -29,6 +30,7 @@ using hglasm::RangeScan;
 using hglasm::TrackerOptions;
 using hglasm::TrackerUpdate;
 using hglasm_test::deg;
+using hglasm_test::expectPoseNear;
 using hglasm_test::LaserSpec;
 using Path = std::function<Pose2D(double)>;
 
@@ -147,15 +149,6 @@ TrackerOptions withoutOdometry() {
   return options;
 }
 
-void expectNear(const Pose2D& estimate, const Pose2D& truth, double max_translation, double max_rotation,
-                const std::string& what) {
-  EXPECT_LT(hglasm_test::translationError(estimate, truth), max_translation)
-      << what << ": " << estimate.x << " " << estimate.y << " " << estimate.theta << " vs " << truth.x << " "
-      << truth.y << " " << truth.theta;
-  EXPECT_LT(hglasm_test::rotationError(estimate, truth), max_rotation)
-      << what << ": " << estimate.theta << " vs " << truth.theta;
-}
-
 // ------------------------------------------------------------------ bad scans
 
 /// The three "nothing to match" scans, as a driver could publish them.
@@ -195,7 +188,7 @@ TEST(Robustness, UnusableScansAreFlaggedAndIntegrateTheOdometryGuess) {
       EXPECT_FALSE(update.new_keyframe) << describe(update);  // the keyframe is kept for when scans return
       EXPECT_EQ(update.match.status, hglasm::MatchStatus::kTooFewPoints) << describe(update);
       EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
-      expectNear(update.pose, robot.truth(0.1 * i), 0.005, deg(0.1), describe(update));
+      expectPoseNear(update.pose, robot.truth(0.1 * i), 0.005, deg(0.1), describe(update));
       EXPECT_GT(update.pose_covariance.trace(), previous_trace) << describe(update);  // uncertainty grows
       previous_trace = update.pose_covariance.trace();
     }
@@ -209,7 +202,7 @@ TEST(Robustness, UnusableScansAreFlaggedAndIntegrateTheOdometryGuess) {
     EXPECT_TRUE(update.matched) << describe(update);
     EXPECT_FALSE(update.fallback) << describe(update);
   }
-  expectNear(update.pose, robot.truth(0.1 * (i - 1)), 0.02, deg(0.3), "after the bad scans");
+  expectPoseNear(update.pose, robot.truth(0.1 * (i - 1)), 0.02, deg(0.3), "after the bad scans");
 }
 
 TEST(Robustness, UnusableScansWithoutOdometryKeepTheConstantVelocity) {
@@ -223,7 +216,7 @@ TEST(Robustness, UnusableScansWithoutOdometryKeepTheConstantVelocity) {
     EXPECT_EQ(update.prediction, PredictionSource::kConstantVelocity) << describe(update);
   }
   // 0.3 s of constant-velocity prediction on a gentle arc stays within a few millimetres.
-  expectNear(robot.tracker().pose(), robot.truth(0.1 * (i - 1)), 0.01, deg(0.2), "after the bad scans");
+  expectPoseNear(robot.tracker().pose(), robot.truth(0.1 * (i - 1)), 0.01, deg(0.2), "after the bad scans");
 }
 
 TEST(Robustness, StructurallyBrokenScansAreFallbacksToo) {
@@ -242,7 +235,7 @@ TEST(Robustness, StructurallyBrokenScansAreFallbacksToo) {
     const TrackerUpdate update = robot.step(0.1 * i, scan);
     EXPECT_NE(robot.lastError(), hglasm::ScanError::kNone);
     EXPECT_TRUE(update.fallback) << describe(update);
-    expectNear(update.pose, robot.truth(0.1 * i), 0.005, deg(0.1), describe(update));
+    expectPoseNear(update.pose, robot.truth(0.1 * i), 0.005, deg(0.1), describe(update));
     ++i;
   }
 }
@@ -262,9 +255,9 @@ TEST(Robustness, InvalidRangesMixedInLeaveTheEstimateUnchanged) {
     b = dirty.step(t, &ranges);
     if (i == 0) continue;
     EXPECT_FALSE(b.fallback) << describe(b);
-    expectNear(b.pose, a.pose, 0.01, deg(0.2), "dirty vs clean at scan " + std::to_string(i));
+    expectPoseNear(b.pose, a.pose, 0.01, deg(0.2), "dirty vs clean at scan " + std::to_string(i));
   }
-  expectNear(b.pose, clean.truth(6.0), 0.03, deg(0.5), "dirty vs truth");
+  expectPoseNear(b.pose, clean.truth(6.0), 0.03, deg(0.5), "dirty vs truth");
 }
 
 // ------------------------------------------------------------------ scanner geometry
@@ -286,7 +279,7 @@ TEST(Robustness, BeamCountChangeMakesANewKeyframeWithOneWarningAndContinues) {
     EXPECT_FALSE(update.fallback) << describe(update);
   }
   EXPECT_EQ(robot.warnings().size(), 1u);  // one warning for one event
-  expectNear(update.pose, robot.truth(4.0), 0.03, deg(0.5), "after the change");
+  expectPoseNear(update.pose, robot.truth(4.0), 0.03, deg(0.5), "after the change");
 }
 
 TEST(Robustness, AngleIncrementChangeWithTheSameBeamCountStillTracks) {
@@ -304,7 +297,7 @@ TEST(Robustness, AngleIncrementChangeWithTheSameBeamCountStillTracks) {
     update = robot.step(0.1 * i);
     EXPECT_FALSE(update.fallback) << describe(update);
   }
-  expectNear(update.pose, robot.truth(3.0), 0.03, deg(0.5), "after the change");
+  expectPoseNear(update.pose, robot.truth(3.0), 0.03, deg(0.5), "after the change");
 }
 
 struct LaserCase {
@@ -341,7 +334,7 @@ TEST_P(LaserLayouts, CorrectEstimate) {
   }
   EXPECT_EQ(fallbacks, 0);
   EXPECT_TRUE(robot.warnings().empty()) << robot.warnings().front();
-  expectNear(update.pose, robot.truth(0.1 * steps), 0.03, deg(0.5), c.name);
+  expectPoseNear(update.pose, robot.truth(0.1 * steps), 0.03, deg(0.5), c.name);
 }
 
 INSTANTIATE_TEST_SUITE_P(Robustness, LaserLayouts, testing::Range(0, 6),
@@ -363,7 +356,7 @@ TEST(Robustness, LoopedSequenceResetsOnceAndRepeatsItself) {
     const TrackerUpdate update = robot.step(0.1 * i);
     if (update.reset) ++resets;
     EXPECT_EQ(update.reset, i == 0) << describe(update);
-    expectNear(update.pose, first[i], 0.01, deg(0.2), "second pass, scan " + std::to_string(i));
+    expectPoseNear(update.pose, first[i], 0.01, deg(0.2), "second pass, scan " + std::to_string(i));
   }
   EXPECT_EQ(resets, 1);
   ASSERT_EQ(robot.warnings().size(), 1u);
@@ -387,7 +380,7 @@ TEST(Robustness, StampsJumpingForwardByMinutesResetOnceAndContinue) {
   EXPECT_NE(robot.warnings()[0].find("forward"), std::string::npos) << robot.warnings()[0];
   // Tracked from the new origin: the motion since 1.1 s.
   const Pose2D since_reset = hglasm_test::relativeByHand(robot.truth(1.1), robot.truth(3.0));
-  expectNear(update.pose, since_reset, 0.03, deg(0.5), "since the reset");
+  expectPoseNear(update.pose, since_reset, 0.03, deg(0.5), "since the reset");
   // A forward gap below max_time_jump (a dropped second of scans) is not a reset.
   const TrackerUpdate gap = robot.stepAt(3.5, 3.5 + offset);
   EXPECT_FALSE(gap.reset) << describe(gap);
@@ -412,8 +405,8 @@ TEST(Robustness, ClockGoingBackWhileMovingResetsOnceAndKeepsUsingTheOdometry) {
   }
   ASSERT_EQ(robot.warnings().size(), 1u) << robot.warnings().back();
   EXPECT_NE(robot.warnings()[0].find("back"), std::string::npos) << robot.warnings()[0];
-  expectNear(update.pose, hglasm_test::relativeByHand(robot.truth(3.1), robot.truth(6.0)), 0.03, deg(0.5),
-             "since the reset");
+  expectPoseNear(update.pose, hglasm_test::relativeByHand(robot.truth(3.1), robot.truth(6.0)), 0.03, deg(0.5),
+                 "since the reset");
 }
 
 // ------------------------------------------------------------------ wheel-odometry faults
@@ -436,7 +429,7 @@ TEST(Robustness, LateOdometryFallsBackToConstantVelocityAndIsFlagged) {
     EXPECT_FALSE(update.fallback) << describe(update);
   }
   EXPECT_GE(constant_velocity, 48);
-  expectNear(update.pose, robot.truth(5.0), 0.03, deg(0.5), "late odometry");
+  expectPoseNear(update.pose, robot.truth(5.0), 0.03, deg(0.5), "late odometry");
   // A moderate delay (within max_extrapolation) is bridged by extrapolating the odometry itself.
   Robot slightly_late(options, circlePath);
   slightly_late.enableOdometry();
@@ -447,7 +440,7 @@ TEST(Robustness, LateOdometryFallsBackToConstantVelocityAndIsFlagged) {
       EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
     }
   }
-  expectNear(update.pose, slightly_late.truth(3.0), 0.03, deg(0.5), "slightly late odometry");
+  expectPoseNear(update.pose, slightly_late.truth(3.0), 0.03, deg(0.5), "slightly late odometry");
 }
 
 TEST(Robustness, OdometryJumpingTenMetresHasABoundedEffectAndIsFlagged) {
@@ -470,7 +463,7 @@ TEST(Robustness, OdometryJumpingTenMetresHasABoundedEffectAndIsFlagged) {
         EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
       }
       // Bounded: the estimate never leaves the true path.
-      expectNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
+      expectPoseNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
     }
     EXPECT_EQ(flagged, 1);
     EXPECT_EQ(robot.warnings().size(), 1u);
@@ -503,8 +496,8 @@ TEST(Robustness, OdometrySpikeOfOneSampleHasABoundedEffect) {
       expectSane(update);
       if (!update.warning.empty()) ++warnings;
       EXPECT_FALSE(update.fallback) << describe(update);
-      expectNear(update.pose, hglasm_test::relativeByHand(circlePath(first_scan), circlePath(stamp)), 0.03,
-                 deg(0.5), describe(update));
+      expectPoseNear(update.pose, hglasm_test::relativeByHand(circlePath(first_scan), circlePath(stamp)),
+                     0.03, deg(0.5), describe(update));
     }
     // The two steps touching the spike warn when it is implausible; a small fraction passes silently.
     EXPECT_EQ(warnings, fraction > 0.1 ? 2 : 0);

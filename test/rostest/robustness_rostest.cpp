@@ -435,6 +435,13 @@ std::string joined(const std::vector<std::string>& lines) {
   return out;
 }
 
+/// Exactly one warning of /odo_a since `logs_before`, and it mentions `topic`.
+void expectOneWarningOfA(std::size_t logs_before, const std::string& topic) {
+  const auto warnings = newLines("/odo_a", rosgraph_msgs::Log::WARN, logs_before);
+  ASSERT_EQ(warnings.size(), 1u) << joined(warnings);
+  EXPECT_NE(warnings[0].find(topic), std::string::npos) << warnings[0];
+}
+
 TEST(Robustness, TfMissingAtStartWaitsWithAThrottledMessageThenStarts) {
   Scene& w = *scene;
   ASSERT_TRUE(waitFor([&] { return w.a->connected() && w.b->connected(); }, 20.0))
@@ -549,11 +556,7 @@ TEST(Robustness, UnusableScansAreFlaggedAndIntegrateTheWheelOdometry) {
     }
   }
   // One warning for the structurally broken (beamless) scans, none per scan.
-  const auto warnings = newLines("/odo_a", rosgraph_msgs::Log::WARN, logs_before);
-  EXPECT_EQ(warnings.size(), 1u) << joined(warnings);
-  if (!warnings.empty()) {
-    EXPECT_NE(warnings[0].find("no beams"), std::string::npos) << warnings[0];
-  }
+  expectOneWarningOfA(logs_before, "no beams");
   const auto statuses = w.recorder.statuses("/odo_a", diagnostics_before);
   EXPECT_TRUE(std::any_of(statuses.begin(), statuses.end(), [](const diagnostic_msgs::DiagnosticStatus& s) {
     return s.level == diagnostic_msgs::DiagnosticStatus::ERROR;
@@ -577,39 +580,29 @@ TEST(Robustness, UnusableScansAreFlaggedAndIntegrateTheWheelOdometry) {
 
 TEST(Robustness, BeamCountAndIncrementChangesMakeANewKeyframeWithOneWarning) {
   Scene& w = *scene;
+  // After the laser changes: a new keyframe at once, tracking without fallbacks, one warning naming what.
+  const auto expect_laser_change_handled = [&](const LaserSpec& laser, const std::string& what,
+                                               const std::string& topic) {
+    const std::size_t logs_before = w.recorder.logCount();
+    w.a->setLaser(laser);
+    StepResult r = step();
+    ASSERT_TRUE(r.ok_a);
+    EXPECT_TRUE(r.a.new_keyframe) << describe(r.a);
+    EXPECT_FALSE(r.a.fallback) << describe(r.a);
+    for (int i = 0; i < 20; ++i) {
+      r = step();
+      ASSERT_TRUE(r.ok_a);
+      EXPECT_FALSE(r.a.fallback) << describe(r.a);
+    }
+    expectATracks(0.04, deg(0.6), "after the " + what + " changed");
+    expectOneWarningOfA(logs_before, topic);
+  };
   // The driver is reconfigured: 270 degrees with 541 beams instead of 180 degrees with 361.
-  std::size_t logs_before = w.recorder.logCount();
-  w.a->setLaser(hglasm_test::laserSpec(deg(270.0), 541));
-  StepResult r = step();
-  ASSERT_TRUE(r.ok_a);
-  EXPECT_TRUE(r.a.new_keyframe) << describe(r.a);
-  EXPECT_FALSE(r.a.fallback) << describe(r.a);
-  for (int i = 0; i < 20; ++i) {
-    r = step();
-    ASSERT_TRUE(r.ok_a);
-    EXPECT_FALSE(r.a.fallback) << describe(r.a);
-  }
-  expectATracks(0.04, deg(0.6), "after the beam count changed");
-  auto warnings = newLines("/odo_a", rosgraph_msgs::Log::WARN, logs_before);
-  ASSERT_EQ(warnings.size(), 1u) << joined(warnings);
-  EXPECT_NE(warnings[0].find("beam count"), std::string::npos) << warnings[0];
-
+  ASSERT_NO_FATAL_FAILURE(
+      expect_laser_change_handled(hglasm_test::laserSpec(deg(270.0), 541), "beam count", "beam count"));
   // The same beam count over another field of view: only angle_increment changes.
-  logs_before = w.recorder.logCount();
-  w.a->setLaser(hglasm_test::laserSpec(deg(240.0), 541));
-  r = step();
-  ASSERT_TRUE(r.ok_a);
-  EXPECT_TRUE(r.a.new_keyframe) << describe(r.a);
-  EXPECT_FALSE(r.a.fallback) << describe(r.a);
-  for (int i = 0; i < 20; ++i) {
-    r = step();
-    ASSERT_TRUE(r.ok_a);
-    EXPECT_FALSE(r.a.fallback) << describe(r.a);
-  }
-  expectATracks(0.04, deg(0.6), "after the increment changed");
-  warnings = newLines("/odo_a", rosgraph_msgs::Log::WARN, logs_before);
-  ASSERT_EQ(warnings.size(), 1u) << joined(warnings);
-  EXPECT_NE(warnings[0].find("angle_increment"), std::string::npos) << warnings[0];
+  ASSERT_NO_FATAL_FAILURE(
+      expect_laser_change_handled(hglasm_test::laserSpec(deg(240.0), 541), "increment", "angle_increment"));
   w.a->setLaser(hglasm_test::halfCircleLaser());
   step();  // back to the original laser (one more warning, not checked)
 }
@@ -651,9 +644,7 @@ TEST(Robustness, WheelOdometryFaultsAreFlaggedAndBounded) {
     EXPECT_FALSE(r.a.fallback) << describe(r.a);
   }
   expectATracks(0.04, deg(0.6), "after the wheel odometry jumped");
-  auto warnings = newLines("/odo_a", rosgraph_msgs::Log::WARN, logs_before);
-  ASSERT_EQ(warnings.size(), 1u) << joined(warnings);
-  EXPECT_NE(warnings[0].find("jumped"), std::string::npos) << warnings[0];
+  ASSERT_NO_FATAL_FAILURE(expectOneWarningOfA(logs_before, "jumped"));
 
   // Wheel odometry stops: constant-velocity prediction (flagged in ~match), still tracking.
   logs_before = w.recorder.logCount();
@@ -743,9 +734,7 @@ TEST(Robustness, TimeGoingBackwardsOrJumpingForwardResetsWithOneWarning) {
     EXPECT_FALSE(r.a.fallback) << describe(r.a);
   }
   expectATracks(0.03, deg(0.5), "after time went back");
-  auto warnings = newLines("/odo_a", rosgraph_msgs::Log::WARN, logs_before);
-  ASSERT_EQ(warnings.size(), 1u) << joined(warnings);
-  EXPECT_NE(warnings[0].find("back"), std::string::npos) << warnings[0];
+  ASSERT_NO_FATAL_FAILURE(expectOneWarningOfA(logs_before, "back"));
 
   // The clock jumps forward by five minutes.
   logs_before = w.recorder.logCount();
@@ -760,9 +749,7 @@ TEST(Robustness, TimeGoingBackwardsOrJumpingForwardResetsWithOneWarning) {
     EXPECT_FALSE(r.a.fallback) << describe(r.a);
   }
   expectATracks(0.03, deg(0.5), "after time jumped forward");
-  warnings = newLines("/odo_a", rosgraph_msgs::Log::WARN, logs_before);
-  ASSERT_EQ(warnings.size(), 1u) << joined(warnings);
-  EXPECT_NE(warnings[0].find("forward"), std::string::npos) << warnings[0];
+  ASSERT_NO_FATAL_FAILURE(expectOneWarningOfA(logs_before, "forward"));
 }
 
 TEST(Robustness, TheOtherInstanceWasIndependentAndCorrectThroughout) {
