@@ -117,21 +117,15 @@ def main():
     datasets = sys.argv[1] if len(sys.argv) > 1 else os.path.join('..', 'shared', 'datasets')
     out_dir = os.path.dirname(os.path.abspath(__file__))
 
-    scans, odom = read_bag(os.path.join(datasets, 'fr079', 'fr079.orig.bag'))
-    block = moving_block(scans, odom, 20, 1.0, 0.3)
-    write(os.path.join(out_dir, 'fr079_scans.txt'), 'fr079: 16 scans spread over the bag + 20 consecutive',
-          'fr079/fr079.orig.bag', '360 beams, 180 deg; the laser is 0.04 m ahead of base_link',
-          scans, odom, spread(16, len(scans)) + block)
-    write_relations(os.path.join(out_dir, 'fr079_relations.txt'), os.path.join(datasets, 'fr079', 'fr079.relations'),
-                    [scans[i].header.stamp.to_sec() for i in block])
-
-    scans, odom = read_bag(os.path.join(datasets, 'intel', 'intel.orig.bag'))
-    block = moving_block(scans, odom, 20, 1.0, 0.3)
-    write(os.path.join(out_dir, 'intel_scans.txt'), 'intel: 16 scans spread over the bag + 20 consecutive',
-          'intel/intel.orig.bag', '180 beams, 180 deg; the laser is at the base origin',
-          scans, odom, spread(16, len(scans)) + block)
-    write_relations(os.path.join(out_dir, 'intel_relations.txt'), os.path.join(datasets, 'intel', 'intel.relations'),
-                    [scans[i].header.stamp.to_sec() for i in block])
+    # The two logs with reference relations: scans spread over the bag, a moving block, its relations.
+    for log, geometry in (('fr079', '360 beams, 180 deg; the laser is 0.04 m ahead of base_link'),
+                          ('intel', '180 beams, 180 deg; the laser is at the base origin')):
+        scans, odom = read_bag(os.path.join(datasets, log, log + '.orig.bag'))
+        block = moving_block(scans, odom, 20, 1.0, 0.3)
+        write(os.path.join(out_dir, log + '_scans.txt'), log + ': 16 scans spread over the bag + 20 consecutive',
+              log + '/' + log + '.orig.bag', geometry, scans, odom, spread(16, len(scans)) + block)
+        write_relations(os.path.join(out_dir, log + '_relations.txt'), os.path.join(datasets, log, log + '.relations'),
+                        [scans[i].header.stamp.to_sec() for i in block])
 
     scans, odom = read_bag(os.path.join(datasets, 'ccny_demo', 'laser_scan_matcher_demo.bag'))
     write(os.path.join(out_dir, 'ccny_scans.txt'), 'ccny demo: 8 scans spread over the bag (no odometry)',
