@@ -73,21 +73,28 @@ bool success(const Pose2D& estimate, const Pose2D& truth) {
          hglasm_test::rotationError(estimate, truth) < 0.01;
 }
 
-/// Full HGLASM-g match of a preset, reference preparation included.
-void benchmarkMatch(benchmark::State& state, Preset preset, const std::vector<PairCase>& cases) {
-  hglasm::ScanMatcher matcher(hglasm::presetOptions(preset));
+/// Times reference preparation + match from the identity over the pairs in turn (ScanMatcher or Mbicp),
+/// and reports the share of matches that found the truth.
+template <typename Matcher>
+void timeMatches(benchmark::State& state, Matcher& matcher, const std::vector<PairCase>& cases) {
   std::size_t next = 0;
   std::int64_t successes = 0, matches = 0;
   for (auto _ : state) {
     const PairCase& pair = cases[next++ % cases.size()];
     matcher.setReference(pair.reference);
-    const hglasm::MatchResult result = matcher.match(pair.scan, Pose2D());
+    const auto result = matcher.match(pair.scan, Pose2D());
     benchmark::DoNotOptimize(result.pose);
     // Tens of nanoseconds: cheaper than pausing the timer around it.
     successes += success(result.pose, pair.truth) ? 1 : 0;
     ++matches;
   }
   state.counters["success"] = matches ? static_cast<double>(successes) / matches : 0.0;
+}
+
+/// Full HGLASM-g match of a preset, reference preparation included.
+void benchmarkMatch(benchmark::State& state, Preset preset, const std::vector<PairCase>& cases) {
+  hglasm::ScanMatcher matcher(hglasm::presetOptions(preset));
+  timeMatches(state, matcher, cases);
   state.counters["beams"] = cases.empty() ? 0.0 : cases.front().reference.beam_count;
 }
 
@@ -117,18 +124,7 @@ void benchmarkTableBuild(benchmark::State& state, const std::vector<PairCase>& c
 /// MbICP alone from a small initial error (within its basin): reference preparation + match.
 void benchmarkMbicp(benchmark::State& state, const std::vector<PairCase>& cases) {
   hglasm::Mbicp mbicp(hglasm::presetOptions(Preset::kSmall).mbicp);
-  std::size_t next = 0;
-  std::int64_t successes = 0, matches = 0;
-  for (auto _ : state) {
-    const PairCase& pair = cases[next++ % cases.size()];
-    mbicp.setReference(pair.reference);
-    const hglasm::MbicpResult result = mbicp.match(pair.scan, Pose2D());
-    benchmark::DoNotOptimize(result.pose);
-    // Tens of nanoseconds: cheaper than pausing the timer around it.
-    successes += success(result.pose, pair.truth) ? 1 : 0;
-    ++matches;
-  }
-  state.counters["success"] = matches ? static_cast<double>(successes) / matches : 0.0;
+  timeMatches(state, mbicp, cases);
 }
 
 }  // namespace
