@@ -48,6 +48,15 @@ Eigen::Matrix3d odometryNoise(const TrackerOptions& options, const Pose2D& motio
   return Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_theta * sigma_theta).asDiagonal();
 }
 
+/// The laser's velocity (vx, vy, omega in the laser frame) from the base's (base frame): the lever arm
+/// of the mount adds omega x t to the translation.
+Eigen::Vector3d laserVelocity(const Pose2D& mount, const Eigen::Vector3d& base_velocity) {
+  const double omega = base_velocity.z();
+  const Eigen::Vector2d at_laser(base_velocity.x() - omega * mount.y, base_velocity.y() + omega * mount.x);
+  const double c = std::cos(mount.theta), s = std::sin(mount.theta);
+  return Eigen::Vector3d(c * at_laser.x() + s * at_laser.y(), -s * at_laser.x() + c * at_laser.y(), omega);
+}
+
 /// Information-weighted mean of a degenerate match and the prediction (both base motions since the
 /// keyframe, first order in the keyframe frame): the match decides the directions it constrains, the
 /// prediction the one it does not (along a featureless corridor). Covariances must be positive definite.
@@ -162,7 +171,8 @@ void OdometryTracker::setKeyframe(const Scan& scan, const Pose2D& pose,
   ++keyframe_id_;
 }
 
-TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::vector<Pose2D>* population_out) {
+TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan,
+                                           std::vector<Pose2D>* population_out) {
   TrackerUpdate update;
   update.stamp = stamp;
   if (population_out) population_out->clear();
@@ -186,6 +196,14 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& scan, std::
       if (dt < 0.0) odometry_.clear();
     }
   }
+
+  // A sweep taken while moving is sheared (the last beam is milliseconds younger than the first), and a
+  // match reads the shear as a small turn of one sign per metre: on fr079 it added up to ~25 degrees.
+  Scan compensated;
+  const bool deskew = options_.deskew && initialised_ && velocity_valid_ && sensor_scan.time_increment != 0.0;
+  if (deskew) compensated = deskewScan(sensor_scan, laserVelocity(laser_mount_, velocity_));
+  const Scan& scan = deskew ? compensated : sensor_scan;
+  update.deskewed = deskew;
 
   const bool usable = static_cast<int>(scan.size()) >= options_.min_points;
   if (!initialised_) {

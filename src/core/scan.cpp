@@ -48,12 +48,18 @@ Scan scanFromRanges(const RangeScan& input, const ScanConversionOptions& options
     scan.beam_index.push_back(i);
   }
   scan.invalid_count = scan.beam_count - static_cast<int>(scan.points.size());
+  if (std::isfinite(input.time_increment) && input.time_increment != 0.0) {
+    scan.time_increment = input.time_increment;
+  } else if (std::isfinite(options.sweep_time) && options.sweep_time > 0.0 && scan.beam_count > 1) {
+    scan.time_increment = options.sweep_time / (scan.beam_count - 1);
+  }
   return scan;
 }
 
 Scan selectBeams(const Scan& scan, int parity) {
   Scan out;
   out.beam_count = scan.beam_count;
+  out.time_increment = scan.time_increment;
   for (std::size_t i = 0; i < scan.points.size(); ++i) {
     if ((scan.beam_index[i] & 1) == (parity & 1)) {
       out.points.push_back(scan.points[i]);
@@ -67,6 +73,18 @@ Scan selectBeams(const Scan& scan, int parity) {
 Scan transformScan(const Scan& scan, const Pose2D& pose) {
   Scan out = scan;
   for (auto& point : out.points) point = pose * point;
+  return out;
+}
+
+Scan deskewScan(const Scan& scan, const Eigen::Vector3d& velocity) {
+  Scan out = scan;
+  if (scan.time_increment == 0.0 || !velocity.allFinite()) return out;
+  for (std::size_t i = 0; i < out.points.size(); ++i) {
+    // The sensor pose at the beam's time, in the frame of the stamp (constant velocity, first order: a
+    // sweep lasts milliseconds).
+    const double dt = scan.beam_index[i] * scan.time_increment;
+    out.points[i] = Pose2D(velocity.x() * dt, velocity.y() * dt, velocity.z() * dt) * out.points[i];
+  }
   return out;
 }
 

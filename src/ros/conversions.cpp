@@ -16,6 +16,7 @@ hglasm::RangeScan rangeScanFromMsg(const sensor_msgs::LaserScan& msg) {
   scan.ranges = msg.ranges;
   scan.angle_min = msg.angle_min;
   scan.angle_increment = msg.angle_increment;
+  scan.time_increment = finiteOr(msg.time_increment, 0.0);
   const double range_min = msg.range_min;
   const double range_max = msg.range_max;
   scan.range_min = (std::isfinite(range_min) && range_min > 0.0) ? range_min : 0.0;

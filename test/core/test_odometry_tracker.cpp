@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <utility>
 
 #include "test_expect.h"
 #include "test_util.h"
@@ -73,9 +74,31 @@ class SimulatedRobot {
   Pose2D truth(double t) const { return path_(t); }
   Pose2D odometryPose() const { return odometry_pose_; }
 
-  /// Scan of the laser on the robot at time t.
+  /// A laser whose sweep lasts `seconds` from the first beam to the last (0: all beams at once).
+  void setSweepTime(double seconds) { sweep_time_ = seconds; }
+
+  /// Scan of the laser on the robot at time t: each beam leaves from where the robot is when it is measured.
   hglasm::Scan scanAt(double t) const {
-    return hglasm_test::simulateScan(world_, hglasm_test::composeByHand(path_(t), mount_), laser_);
+    if (sweep_time_ <= 0.0) {
+      return hglasm_test::simulateScan(world_, hglasm_test::composeByHand(path_(t), mount_), laser_);
+    }
+    hglasm::Scan scan;
+    scan.beam_count = laser_.beams;
+    scan.time_increment = sweep_time_ / (laser_.beams - 1);
+    for (int i = 0; i < laser_.beams; ++i) {
+      const Pose2D sensor = hglasm_test::composeByHand(path_(t + i * scan.time_increment), mount_);
+      const double local = laser_.angle_min + i * laser_.angle_increment;
+      const double range = hglasm_test::castRay(
+          world_, Eigen::Vector2d(sensor.x, sensor.y),
+          Eigen::Vector2d(std::cos(sensor.theta + local), std::sin(sensor.theta + local)));
+      if (!(range >= laser_.range_min && range <= laser_.range_max)) {
+        ++scan.invalid_count;
+        continue;
+      }
+      scan.points.emplace_back(range * std::cos(local), range * std::sin(local));
+      scan.beam_index.push_back(i);
+    }
+    return scan;
   }
 
   /// Advances to time t: wheel odometry at 50 Hz up to t, then one scan at t (or `scan` if given).
@@ -104,6 +127,7 @@ class SimulatedRobot {
   hglasm_test::World world_;
   hglasm_test::LaserSpec laser_;
   Pose2D mount_;
+  double sweep_time_ = 0.0;
   bool odometry_ = false;
   double scale_error_ = 0.0;
   double drift_per_metre_ = 0.0;
@@ -183,6 +207,43 @@ TEST(OdometryTracker, LaserMountIsAccountedFor) {
   const Pose2D truth = robot.truth(10.0);  // the base, not the laser
   EXPECT_EQ(fallbacks, 0);
   hglasm_test::expectPoseNear(last.pose, truth, 0.03, hglasm_test::deg(0.5), "final pose");
+}
+
+TEST(OdometryTracker, DeskewUndoesTheShearOfASweepTakenWhileMoving) {
+  // A slow laser (100 ms from the first beam to the last, like a Hokuyo URG), mounted off-centre on the
+  // robot driving the circle: each sweep is sheared by 5 cm and 1.9 degrees. Compared: the motion from
+  // 1 s to 20 s (the first keyframe is taken before there is a velocity to de-skew it with).
+  const auto drive_swept = [](bool deskew, int* deskewed) {
+    TrackerOptions options = withoutOdometry();
+    options.deskew = deskew;
+    SimulatedRobot robot(options, circlePath);
+    robot.setMount(Pose2D(0.3, 0.1, 0.2));
+    robot.setSweepTime(0.1);
+    int fallbacks = 0;
+    *deskewed = 0;
+    Pose2D at_one_second, last;
+    for (int i = 0; i <= 200; ++i) {  // 20 s at 10 Hz: 10 m, 2/3 of a turn
+      const TrackerUpdate update = robot.step(0.1 * i);
+      expectSane(update);
+      if (update.fallback) ++fallbacks;
+      if (update.deskewed) ++*deskewed;
+      if (i == 10) at_one_second = update.pose;
+      last = update.pose;
+    }
+    EXPECT_EQ(fallbacks, 0);
+    return std::make_pair(hglasm::relativePose(at_one_second, last),
+                          hglasm::relativePose(robot.truth(1.0), robot.truth(20.0)));
+  };
+  int deskewed = 0;
+  const auto [compensated, truth] = drive_swept(true, &deskewed);
+  EXPECT_GE(deskewed, 198);  // all but the first two scans (no velocity yet)
+  hglasm_test::expectPoseNear(compensated, truth, 0.01, hglasm_test::deg(0.1),
+                              "de-skewed");  // 3 mm, 0.01 deg
+  const auto [sheared, same_truth] = drive_swept(false, &deskewed);
+  EXPECT_EQ(deskewed, 0);
+  // What it undoes (11 cm and 4.7 degrees here).
+  EXPECT_GT(hglasm_test::translationError(sheared, same_truth), 0.05);
+  EXPECT_GT(hglasm_test::rotationError(sheared, same_truth), hglasm_test::deg(2.0));
 }
 
 TEST(OdometryTracker, KeyframesFollowKeyframeDistance) {

@@ -1,5 +1,5 @@
 // Scan conversion: REP-117 validity, descending and 360-degree scans, any beam count, mirror, decimation,
-// structurally broken scans, beam parity selection and transforms.
+// structurally broken scans, beam parity selection, transforms, beam times and motion compensation.
 #include "hglasm_odometry/core/scan.h"
 
 #include <gtest/gtest.h>
@@ -268,6 +268,66 @@ TEST(TransformScan, MovesPointsKeepsIndices) {
   expectPoint(moved.points[1], -1.0, -1.0);
   EXPECT_EQ(moved.beam_index, scan.beam_index);
   EXPECT_EQ(moved.beam_count, scan.beam_count);
+}
+
+TEST(ScanFromRanges, BeamTimesComeFromTheScanOrElseTheSweepTime) {
+  RangeScan ranges = makeRanges({1.0f, 1.0f, 1.0f, 1.0f, 1.0f}, 0.0, 0.1);
+  EXPECT_EQ(hglasm::scanFromRanges(ranges).time_increment, 0.0);  // nothing known: no beam times
+  ScanConversionOptions options;
+  options.sweep_time = 0.02;
+  EXPECT_DOUBLE_EQ(hglasm::scanFromRanges(ranges, options).time_increment, 0.005);  // 4 intervals
+  ranges.time_increment = 1e-4;  // the driver's own figure wins
+  EXPECT_EQ(hglasm::scanFromRanges(ranges, options).time_increment, 1e-4);
+  options.beam_step = 2;  // decimation keeps the original beam indices, so the increment is per beam
+  EXPECT_EQ(hglasm::scanFromRanges(ranges, options).time_increment, 1e-4);
+  for (double broken : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    ranges.time_increment = broken;
+    EXPECT_DOUBLE_EQ(hglasm::scanFromRanges(ranges, options).time_increment, 0.005) << broken;
+    EXPECT_EQ(hglasm::scanFromRanges(ranges).time_increment, 0.0) << broken;
+  }
+  const Scan scan = hglasm::scanFromRanges(ranges, options);
+  EXPECT_EQ(hglasm::selectBeams(scan, 1).time_increment, scan.time_increment);
+}
+
+TEST(DeskewScan, MovesEachPointToTheStamp) {
+  Scan scan;  // three beams that all see a point 1 m ahead
+  scan.points.assign(3, Eigen::Vector2d(1.0, 0.0));
+  scan.beam_index = {0, 1, 2};
+  scan.beam_count = 3;
+  scan.time_increment = 0.01;
+  // Beam 2 is measured 0.02 s after the stamp: the sensor has moved 0.02 m along x and turned pi/100.
+  const Scan deskewed = hglasm::deskewScan(scan, Eigen::Vector3d(1.0, 0.0, kPi / 2.0));
+  ASSERT_EQ(deskewed.size(), 3u);
+  expectPoint(deskewed.points[0], 1.0, 0.0);
+  expectPoint(deskewed.points[1], 0.01 + std::cos(kPi / 200.0), std::sin(kPi / 200.0));
+  expectPoint(deskewed.points[2], 0.02 + std::cos(kPi / 100.0), std::sin(kPi / 100.0));
+  EXPECT_EQ(deskewed.beam_index, scan.beam_index);
+}
+
+TEST(DeskewScan, StraightensAWallSweptWhileDriving) {
+  // Driving at 2 m/s towards a wall 3 m ahead; a 100 ms sweep sees its right end from 20 cm farther away
+  // than its left end, so the wall looks turned by about 4 degrees.
+  const int beams = 61;
+  const double sweep = 0.1, speed = 2.0;
+  RangeScan ranges = makeRanges(std::vector<float>(beams), -kPi / 6.0, (kPi / 3.0) / (beams - 1), 0.1, 20.0);
+  std::vector<double> exact(beams);
+  for (int i = 0; i < beams; ++i) {
+    const double when = i * sweep / (beams - 1);
+    const double angle = ranges.angle_min + i * ranges.angle_increment;
+    exact[i] = (3.0 - speed * when) / std::cos(angle);
+    ranges.ranges[i] = static_cast<float>(exact[i]);
+  }
+  ranges.time_increment = sweep / (beams - 1);
+  const Scan skewed = hglasm::scanFromRanges(ranges);
+  ASSERT_EQ(skewed.size(), static_cast<std::size_t>(beams));
+  EXPECT_GT(skewed.points.front().x() - skewed.points.back().x(), 0.19);
+  const Scan deskewed = hglasm::deskewScan(skewed, Eigen::Vector3d(speed, 0.0, 0.0));
+  for (const auto& point : deskewed.points) EXPECT_NEAR(point.x(), 3.0, 1e-5);  // float ranges
+  // Not moving, or beam times unknown: nothing changes.
+  EXPECT_EQ(hglasm::deskewScan(skewed, Eigen::Vector3d::Zero()).points, skewed.points);
+  Scan untimed = skewed;
+  untimed.time_increment = 0.0;
+  EXPECT_EQ(hglasm::deskewScan(untimed, Eigen::Vector3d(speed, 0.0, 1.0)).points, skewed.points);
 }
 
 }  // namespace

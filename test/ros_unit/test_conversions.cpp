@@ -62,6 +62,7 @@ TEST(RangeScanFromMsg, CopiesPolarFieldsAndKeepsInvalidRangesForTheCore) {
   EXPECT_NEAR(scan.angle_increment, 0.2, 1e-7);
   EXPECT_NEAR(scan.range_min, 0.1, 1e-7);
   EXPECT_NEAR(scan.range_max, 30.0, 1e-6);
+  EXPECT_EQ(scan.time_increment, 0.0);  // makeScan leaves the beam times out, as converted logs do
 
   // Only the first beam is valid per REP-117 (NaN, +-inf, 0 and > range_max are not).
   hglasm::ScanError error = hglasm::ScanError::kBadAngles;
@@ -71,6 +72,16 @@ TEST(RangeScanFromMsg, CopiesPolarFieldsAndKeepsInvalidRangesForTheCore) {
   EXPECT_EQ(points.invalid_count, 5);
   EXPECT_NEAR(points.points[0].x(), 2.0 * std::cos(-0.5), 1e-6);
   EXPECT_NEAR(points.points[0].y(), 2.0 * std::sin(-0.5), 1e-6);
+}
+
+TEST(RangeScanFromMsg, BeamTimesAreCopiedAndNonFiniteOnesDropped) {
+  sensor_msgs::LaserScan msg = makeScan(3, 0.0, 0.1, 5.0f);
+  msg.time_increment = 2.5e-5f;
+  EXPECT_FLOAT_EQ(rangeScanFromMsg(msg).time_increment, 2.5e-5f);
+  for (float broken : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    msg.time_increment = broken;
+    EXPECT_EQ(rangeScanFromMsg(msg).time_increment, 0.0) << broken;
+  }
 }
 
 TEST(RangeScanFromMsg, NonFiniteRangeLimitsDoNotInvalidateEveryBeam) {

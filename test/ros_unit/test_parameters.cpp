@@ -154,6 +154,10 @@ TEST(Parameters, OutOfRangeValuesNameTheParameter) {
   EXPECT_NE(loadError(params({{"scan/min_range", 5.0}, {"scan/max_range", 2.0}})).find("~scan/max_range"),
             std::string::npos);
   EXPECT_NE(loadError(params({{"odom_frame", "base_link"}})).find("~base_frame"), std::string::npos);
+  EXPECT_NE(
+      loadError(params({{"scan/sweep_time", -0.01}})).find("~scan/sweep_time must be a number in [0, 1]"),
+      std::string::npos);
+  EXPECT_NE(loadError(params({{"scan/deskew", 1.5}})).find("~scan/deskew"), std::string::npos);
 }
 
 TEST(Parameters, NonFiniteNumbersAreRejectedExceptAnInfiniteMaxRange) {

@@ -26,6 +26,9 @@ struct TrackerOptions {
   double odometry_max_extrapolation = 0.25;  ///< seconds; beyond, wheel odometry counts as stale
   double max_time_jump = 60.0;        ///< seconds forward between scans that triggers a reset
   bool use_odometry = true;
+  /// Motion-compensate each scan with the current velocity estimate when its beams' times are known
+  /// (Scan::time_increment): a sweep taken while moving is sheared, which a match reads as a small turn.
+  bool deskew = true;
   /// Wheel odometry implying faster motion than this between two scans is implausible (a jump): the
   /// constant-velocity prediction is used instead. A margin of 0.2 m / 0.2 rad is added for jitter.
   double max_odometry_speed = 5.0;       ///< m/s
@@ -64,6 +67,7 @@ struct TrackerUpdate {
   bool matched = false;       ///< a match was attempted (false for the first scan and after resets)
   bool fallback = false;      ///< match failed: the prediction was integrated instead
   bool jump_rejected = false; ///< the pre-aligned match strayed from the prediction and lost to it
+  bool deskewed = false;      ///< the scan was motion-compensated before matching
   bool new_keyframe = false;
   double table_build_ms = 0.0;  ///< lookup-table build of the new keyframe (wall ms; 0 if none)
   int keyframe_id = 0;

@@ -19,6 +19,7 @@ struct RangeScan {
   double angle_increment = 0.0;
   double range_min = 0.0;
   double range_max = std::numeric_limits<double>::infinity();
+  double time_increment = 0.0;  ///< seconds between consecutive beams (0: not known)
 };
 
 /// How a RangeScan becomes points. Ranges outside [max(range_min, min_range), min(range_max, max_range)],
@@ -28,6 +29,9 @@ struct ScanConversionOptions {
   double max_range = std::numeric_limits<double>::infinity();    ///< extra upper limit, metres
   int beam_step = 1;                                             ///< keep every n-th beam (decimation)
   bool mirror = false;  ///< negate beam angles: an upside-down laser seen from above
+  /// Seconds from the first beam to the last, assumed when the scan's own time_increment is 0 or not
+  /// finite (converted logs, drivers that leave it out). 0: the beams' times stay unknown.
+  double sweep_time = 0.0;
 };
 
 /// Valid points of one scan in the sensor frame, in beam order.
@@ -36,6 +40,9 @@ struct Scan {
   std::vector<int> beam_index;  ///< original beam index of each point (consecutive beams are neighbours)
   int beam_count = 0;           ///< beams in the source scan, valid or not
   int invalid_count = 0;        ///< beams dropped as invalid
+  /// Beam i was measured i * time_increment seconds after the scan's stamp (REP: the stamp is the first
+  /// beam's time). 0: not known.
+  double time_increment = 0.0;
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }
@@ -55,5 +62,10 @@ Scan selectBeams(const Scan& scan, int parity);
 
 /// Applies `pose` to every point (beam indices kept).
 Scan transformScan(const Scan& scan, const Pose2D& pose);
+
+/// Motion compensation: moves every point to where the sensor would have seen it at the scan's stamp,
+/// the sensor moving with `velocity` (vx, vy in m/s, omega in rad/s, in its own frame) during the sweep.
+/// Returns the scan unchanged when its beams' times are not known (time_increment 0).
+Scan deskewScan(const Scan& scan, const Eigen::Vector3d& velocity);
 
 }  // namespace hglasm
