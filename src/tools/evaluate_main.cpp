@@ -349,6 +349,8 @@ struct Run {
   std::vector<hglasm::StampedPose> trajectory;  ///< published base poses
   std::size_t processed = 0, skipped = 0;
   int matched = 0, fallbacks = 0, keyframes = 0, resets = 0, conversion_errors = 0, warnings = 0;
+  int deskewed = 0;
+  std::string beam_times;  ///< where the first scan's beam times came from
   std::map<std::string, int> statuses, predictions;
   std::vector<double> total_ms, convert_ms, prealign_ms, refine_ms, table_ms;
 };
@@ -415,6 +417,13 @@ Run runTracker(const Arguments& args, const hglasm::TrackerOptions& options,
     if (update.new_keyframe) run.table_ms.push_back(update.table_build_ms);
     ++run.predictions[hglasm::toString(update.prediction)];
     run.fallbacks += update.fallback;
+    run.deskewed += update.deskewed;
+    if (run.beam_times.empty()) {
+      char text[96];
+      std::snprintf(text, sizeof text, "%.3g s per beam (%s)", scan.time_increment,
+                    ranges.time_increment != 0.0 ? "the bag's time_increment" : "scan/sweep_time");
+      run.beam_times = scan.time_increment != 0.0 ? text : "not known (time_increment and scan/sweep_time are 0)";
+    }
     run.keyframes += update.new_keyframe;
     run.resets += update.reset;
     if (!update.warning.empty() && ++run.warnings <= 20 && !args.quiet) {
@@ -432,6 +441,7 @@ void printRun(const Run& run, double data_seconds) {
               run.matched, run.keyframes, run.resets, run.trajectory.size());
   std::printf("fallbacks     %d (%.2f %% of scans), conversion errors %d, warnings %d\n", run.fallbacks,
               scans ? 100.0 * run.fallbacks / scans : 0.0, run.conversion_errors, run.warnings);
+  std::printf("de-skewed     %d scans; beam times %s\n", run.deskewed, run.beam_times.c_str());
   std::printf("match status ");
   for (const auto& entry : run.statuses) std::printf(" %s %d", entry.first.c_str(), entry.second);
   std::printf("\nprediction   ");
