@@ -409,6 +409,7 @@ void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::Tra
   match.status = toMsg(update.match.status);
   match.status_text = hglasm::toString(update.match.status);
   match.jump_rejected = update.jump_rejected;
+  match.deskewed = update.deskewed;
   match.mbicp_status = toMsg(update.match.mbicp_status);
   match.matched = update.matched;
   match.fallback = update.fallback;

@@ -14,6 +14,7 @@
 //   max_short_trans_error  metres: the same over the relations spanning at most 10 s
 //   max_short_rot_error_deg  degrees: the same over the relations spanning at most 10 s
 //   max_fallback_ratio     bound on the fraction of matches that fell back to the prediction
+//   min_deskewed_ratio     the fraction of matches that must have been de-skewed (default 0: not checked)
 //   timeout                wall seconds for the whole replay (default 100)
 #include <gtest/gtest.h>
 
@@ -59,6 +60,7 @@ struct Settings {
   double max_short_trans_error = 0.05;
   double max_short_rot_error_deg = 1.0;
   double max_fallback_ratio = 0.1;
+  double min_deskewed_ratio = 0.0;
   double timeout = 100.0;
 };
 
@@ -105,6 +107,7 @@ std::unique_ptr<Recording> record() {
   private_nh.getParam("max_short_trans_error", s.max_short_trans_error);
   private_nh.getParam("max_short_rot_error_deg", s.max_short_rot_error_deg);
   private_nh.getParam("max_fallback_ratio", s.max_fallback_ratio);
+  private_nh.getParam("min_deskewed_ratio", s.min_deskewed_ratio);
   private_nh.getParam("timeout", s.timeout);
 
   // The bag's scan stamps and wheel odometry.
@@ -297,6 +300,18 @@ TEST_F(OdometryReplay, FallbacksAreRare) {
               matched, fallbacks, ratio, resets, total_ms / r.matches.size());
   EXPECT_EQ(resets, 1) << "only the first scan starts the odometry";
   EXPECT_LE(ratio, r.settings.max_fallback_ratio);
+}
+
+TEST_F(OdometryReplay, ScansAreDeskewed) {
+  const Recording& r = *recording_;
+  int matched = 0, deskewed = 0;
+  for (const auto& m : r.matches) {
+    matched += m.matched;
+    deskewed += m.matched && m.deskewed;
+  }
+  ASSERT_GT(matched, 0);
+  std::printf("[measured] %d of %d matches de-skewed\n", deskewed, matched);
+  EXPECT_GE(static_cast<double>(deskewed) / matched, r.settings.min_deskewed_ratio);
 }
 
 TEST_F(OdometryReplay, TrajectoryMatchesTheReferenceRelations) {
