@@ -79,25 +79,12 @@ class SimulatedRobot {
 
   /// Scan of the laser on the robot at time t: each beam leaves from where the robot is when it is measured.
   hglasm::Scan scanAt(double t) const {
-    if (sweep_time_ <= 0.0) {
-      return hglasm_test::simulateScan(world_, hglasm_test::composeByHand(path_(t), mount_), laser_);
-    }
-    hglasm::Scan scan;
-    scan.beam_count = laser_.beams;
-    scan.time_increment = sweep_time_ / (laser_.beams - 1);
-    for (int i = 0; i < laser_.beams; ++i) {
-      const Pose2D sensor = hglasm_test::composeByHand(path_(t + i * scan.time_increment), mount_);
-      const double local = laser_.angle_min + i * laser_.angle_increment;
-      const double range = hglasm_test::castRay(
-          world_, Eigen::Vector2d(sensor.x, sensor.y),
-          Eigen::Vector2d(std::cos(sensor.theta + local), std::sin(sensor.theta + local)));
-      if (!(range >= laser_.range_min && range <= laser_.range_max)) {
-        ++scan.invalid_count;
-        continue;
-      }
-      scan.points.emplace_back(range * std::cos(local), range * std::sin(local));
-      scan.beam_index.push_back(i);
-    }
+    const double time_increment = sweep_time_ > 0.0 ? sweep_time_ / (laser_.beams - 1) : 0.0;
+    hglasm::Scan scan = hglasm_test::simulateSweep(
+        world_,
+        [&](int beam) { return hglasm_test::composeByHand(path_(t + beam * time_increment), mount_); },
+        laser_);
+    scan.time_increment = time_increment;
     return scan;
   }
 

@@ -182,15 +182,18 @@ inline hglasm::RangeScan simulateRanges(const World& world, const hglasm::Pose2D
   return scan;
 }
 
-/// The same scan as points in the sensor frame, converted here (not by the core) with double precision.
-inline hglasm::Scan simulateScan(const World& world, const hglasm::Pose2D& pose, const LaserSpec& spec) {
+/// A laser that may move while it sweeps: beam i is measured from `sensor_pose(i)` (world frame) and
+/// expressed in that pose's frame, converted here (not by the core) with double precision.
+template <typename PoseOfBeam>
+hglasm::Scan simulateSweep(const World& world, PoseOfBeam sensor_pose, const LaserSpec& spec) {
   hglasm::Scan scan;
   scan.beam_count = spec.beams;
-  const Eigen::Vector2d origin(pose.x, pose.y);
   for (int i = 0; i < spec.beams; ++i) {
+    const hglasm::Pose2D pose = sensor_pose(i);
     const double local = spec.angle_min + i * spec.angle_increment;
     const double angle = pose.theta + local;
-    const double range = castRay(world, origin, Eigen::Vector2d(std::cos(angle), std::sin(angle)));
+    const double range =
+        castRay(world, Eigen::Vector2d(pose.x, pose.y), Eigen::Vector2d(std::cos(angle), std::sin(angle)));
     if (!(range >= spec.range_min && range <= spec.range_max)) {
       ++scan.invalid_count;
       continue;
@@ -199,6 +202,12 @@ inline hglasm::Scan simulateScan(const World& world, const hglasm::Pose2D& pose,
     scan.beam_index.push_back(i);
   }
   return scan;
+}
+
+/// The scan of simulateRanges as points in the sensor frame (every beam at the same instant).
+inline hglasm::Scan simulateScan(const World& world, const hglasm::Pose2D& pose, const LaserSpec& spec) {
+  return simulateSweep(
+      world, [&pose](int) { return pose; }, spec);
 }
 
 /// Moves points by `pose` without the core (pose * p).
