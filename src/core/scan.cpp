@@ -48,9 +48,12 @@ Scan scanFromRanges(const RangeScan& input, const ScanConversionOptions& options
     scan.beam_index.push_back(i);
   }
   scan.invalid_count = scan.beam_count - static_cast<int>(scan.points.size());
-  if (std::isfinite(input.time_increment) && input.time_increment != 0.0) {
+  // A sweep longer than a second is no 2D laser's: such a time_increment is a driver's mistake.
+  const double stated_sweep = std::abs(input.time_increment) * (scan.beam_count - 1);
+  if (std::isfinite(input.time_increment) && input.time_increment != 0.0 && stated_sweep <= kMaxSweepTime) {
     scan.time_increment = input.time_increment;
-  } else if (std::isfinite(options.sweep_time) && options.sweep_time > 0.0 && scan.beam_count > 1) {
+  } else if (std::isfinite(options.sweep_time) && options.sweep_time > 0.0 &&
+             options.sweep_time <= kMaxSweepTime && scan.beam_count > 1) {
     scan.time_increment = options.sweep_time / (scan.beam_count - 1);
   }
   return scan;
@@ -78,7 +81,7 @@ Scan transformScan(const Scan& scan, const Pose2D& pose) {
 
 Scan deskewScan(const Scan& scan, const Eigen::Vector3d& velocity) {
   Scan out = scan;
-  if (scan.time_increment == 0.0 || !velocity.allFinite()) return out;
+  if (!std::isfinite(scan.time_increment) || scan.time_increment == 0.0 || !velocity.allFinite()) return out;
   for (std::size_t i = 0; i < out.points.size(); ++i) {
     // The sensor pose at the beam's time, in the frame of the stamp (constant velocity, first order: a
     // sweep lasts milliseconds).

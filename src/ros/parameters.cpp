@@ -255,7 +255,7 @@ void readOptions(ParamTree& tree, LaserOdometryOptions* options) {
   tree.number("scan/max_range", &tracker.conversion.max_range, 0.0, kInf, true, true);
   tree.integer("scan/beam_step", &tracker.conversion.beam_step, 1, 100);
   tree.boolean("scan/deskew", &tracker.deskew);
-  tree.number("scan/sweep_time", &tracker.conversion.sweep_time, 0.0, 1.0);
+  tree.number("scan/sweep_time", &tracker.conversion.sweep_time, 0.0, hglasm::kMaxSweepTime);
 
   // Lookup tables (the fine one, and the coarse one of the first GA generations).
   for (const char* name : {"table", "coarse_table"}) {

@@ -285,6 +285,8 @@ TEST(ScanFromRanges, BeamTimesComeFromTheScanOrElseTheSweepTime) {
     EXPECT_DOUBLE_EQ(hglasm::scanFromRanges(ranges, options).time_increment, 0.005) << broken;
     EXPECT_EQ(hglasm::scanFromRanges(ranges).time_increment, 0.0) << broken;
   }
+  ranges.time_increment = 0.5;  // a 2 s sweep: a driver's mistake, not a 2D laser
+  EXPECT_DOUBLE_EQ(hglasm::scanFromRanges(ranges, options).time_increment, 0.005);
   const Scan scan = hglasm::scanFromRanges(ranges, options);
   EXPECT_EQ(hglasm::selectBeams(scan, 1).time_increment, scan.time_increment);
 }
@@ -327,6 +329,8 @@ TEST(DeskewScan, StraightensAWallSweptWhileDriving) {
   EXPECT_EQ(hglasm::deskewScan(skewed, Eigen::Vector3d::Zero()).points, skewed.points);
   Scan untimed = skewed;
   untimed.time_increment = 0.0;
+  EXPECT_EQ(hglasm::deskewScan(untimed, Eigen::Vector3d(speed, 0.0, 1.0)).points, skewed.points);
+  untimed.time_increment = std::numeric_limits<double>::quiet_NaN();  // never NaN points
   EXPECT_EQ(hglasm::deskewScan(untimed, Eigen::Vector3d(speed, 0.0, 1.0)).points, skewed.points);
 }
 

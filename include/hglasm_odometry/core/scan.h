@@ -22,6 +22,9 @@ struct RangeScan {
   double time_increment = 0.0;  ///< seconds between consecutive beams (0: not known)
 };
 
+/// Longest sweep (first beam to last, seconds) taken as a scan's timing; longer ones are ignored.
+constexpr double kMaxSweepTime = 1.0;
+
 /// How a RangeScan becomes points. Ranges outside [max(range_min, min_range), min(range_max, max_range)],
 /// NaN, +-inf, zero and negative ranges are invalid and never used (REP-117).
 struct ScanConversionOptions {
@@ -40,8 +43,8 @@ struct Scan {
   std::vector<int> beam_index;  ///< original beam index of each point (consecutive beams are neighbours)
   int beam_count = 0;           ///< beams in the source scan, valid or not
   int invalid_count = 0;        ///< beams dropped as invalid
-  /// Beam i was measured i * time_increment seconds after the scan's stamp (REP: the stamp is the first
-  /// beam's time). 0: not known.
+  /// Beam i was measured i * time_increment seconds after the scan's stamp (sensor_msgs/LaserScan: the
+  /// stamp is the first beam's time). 0: not known.
   double time_increment = 0.0;
 
   std::size_t size() const { return points.size(); }
