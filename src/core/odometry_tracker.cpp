@@ -200,7 +200,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   // A sweep taken while moving is sheared (the last beam is milliseconds younger than the first), and a
   // match reads the shear as a small turn of one sign per metre: on fr079 it added up to ~25 degrees.
   Scan compensated;
-  const bool deskew = options_.deskew && initialised_ && velocity_valid_ && sensor_scan.time_increment != 0.0;
+  const bool deskew = options_.deskew && initialised_ && velocity_valid_ && sensor_scan.hasBeamTimes();
   if (deskew) compensated = deskewScan(sensor_scan, laserVelocity(laser_mount_, velocity_));
   const Scan& scan = deskew ? compensated : sensor_scan;
   update.deskewed = deskew;

@@ -81,7 +81,7 @@ Scan transformScan(const Scan& scan, const Pose2D& pose) {
 
 Scan deskewScan(const Scan& scan, const Eigen::Vector3d& velocity) {
   Scan out = scan;
-  if (!std::isfinite(scan.time_increment) || scan.time_increment == 0.0 || !velocity.allFinite()) return out;
+  if (!scan.hasBeamTimes() || !velocity.allFinite()) return out;
   for (std::size_t i = 0; i < out.points.size(); ++i) {
     // The sensor pose at the beam's time, in the frame of the stamp (constant velocity, first order: a
     // sweep lasts milliseconds).

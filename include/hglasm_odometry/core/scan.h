@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstddef>
 #include <limits>
 #include <string>
@@ -49,6 +50,7 @@ struct Scan {
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }
+  bool hasBeamTimes() const { return std::isfinite(time_increment) && time_increment != 0.0; }
 };
 
 /// Why a RangeScan could not be converted at all (its points are then empty).
