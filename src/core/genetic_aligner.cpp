@@ -79,20 +79,46 @@ void seedLatinHypercube(int bits, std::mt19937_64& rng, std::vector<int>* slices
 
 }  // namespace
 
+SearchEffort effortOf(const GeneticOptions& options) {
+  SearchEffort effort;
+  effort.box = options.box;
+  effort.population = options.population;
+  effort.generations = options.generations;
+  effort.runs = options.runs;
+  effort.coarse_generations = options.coarse_generations;
+  return effort;
+}
+
+namespace {
+
+/// Sizes the GA can work with whatever it was given.
+SearchEffort sanitised(SearchEffort effort) {
+  effort.population = std::max(2, effort.population);
+  effort.generations = std::max(1, effort.generations);
+  effort.runs = std::max(1, effort.runs);
+  effort.coarse_generations = std::max(0, effort.coarse_generations);
+  effort.box.half_theta = std::min(std::abs(effort.box.half_theta), M_PI);
+  effort.box.half_x = std::abs(effort.box.half_x);
+  effort.box.half_y = std::abs(effort.box.half_y);
+  return effort;
+}
+
+}  // namespace
+
 GeneticAligner::GeneticAligner(const GeneticOptions& options) : options_(options), rng_(options.seed) {
-  options_.population = std::max(2, options_.population);
-  options_.generations = std::max(1, options_.generations);
-  options_.runs = std::max(1, options_.runs);
+  const SearchEffort effort = sanitised(effortOf(options_));
+  options_.population = effort.population;
+  options_.generations = effort.generations;
+  options_.runs = effort.runs;
+  options_.box = effort.box;
   options_.bits_per_gene = std::clamp(options_.bits_per_gene, 2, 20);
   options_.tournament_size = std::max(1, options_.tournament_size);
-  options_.box.half_theta = std::min(std::abs(options_.box.half_theta), M_PI);
-  options_.box.half_x = std::abs(options_.box.half_x);
-  options_.box.half_y = std::abs(options_.box.half_y);
 }
 
 PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector<Eigen::Vector2d>& all_points,
                                      const Pose2D& guess, std::vector<Pose2D>* population_out,
-                                     const LookupTable* coarse_table) {
+                                     const LookupTable* coarse_table, const SearchEffort* effort_override) {
+  const SearchEffort effort = effort_override ? sanitised(*effort_override) : effortOf(options_);
   const std::size_t limit =
       options_.max_points > 0 ? static_cast<std::size_t>(options_.max_points) : all_points.size();
   const std::vector<Eigen::Vector2d>* selected = &all_points;
@@ -109,9 +135,9 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
   result.fitness = table.fitness(points, guess);
   result.evaluations = 1;
 
-  const Codec codec(options_.box, guess, options_.bits_per_gene);
+  const Codec codec(effort.box, guess, options_.bits_per_gene);
   const int total_bits = codec.totalBits();
-  const int population_size = options_.population;
+  const int population_size = effort.population;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::uniform_int_distribution<int> random_member(0, population_size - 1);
   std::uniform_int_distribution<int> random_cut(1, total_bits - 1);
@@ -119,7 +145,7 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
   std::vector<Individual> population(population_size), offspring(population_size);
   std::vector<int> slices;
   const int elite_count = std::clamp(options_.elite_count, 1, population_size - 1);
-  const int coarse_generations = coarse_table && !coarse_table->empty() ? options_.coarse_generations : 0;
+  const int coarse_generations = coarse_table && !coarse_table->empty() ? effort.coarse_generations : 0;
   const LookupTable* scoring = &table;
   auto evaluate = [&](Individual& individual) {
     individual.fitness = scoring->fitness(points, codec.decode(individual.chromosome));
@@ -127,7 +153,7 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
   };
   auto tournament = [&]() -> const Individual& {
     const Individual* winner = &population[random_member(rng_)];
-    for (int k = 1; k < options_.tournament_size; ++k) {
+    for (int k = 1; k < std::min(options_.tournament_size, population_size); ++k) {
       const Individual& challenger = population[random_member(rng_)];
       if (challenger.fitness > winner->fitness) winner = &challenger;
     }
@@ -149,11 +175,11 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
 
   std::vector<Individual> best_run_population;
   std::uint32_t best_run_fitness = 0;
-  for (int run = 0; run < options_.runs; ++run) {
+  for (int run = 0; run < effort.runs; ++run) {
     scoring = coarse_generations > 0 ? coarse_table : &table;
     seedLatinHypercube(options_.bits_per_gene, rng_, &slices, &population);
     for (auto& individual : population) evaluate(individual);
-    for (int generation = 1; generation < options_.generations; ++generation) {
+    for (int generation = 1; generation < effort.generations; ++generation) {
       if (generation == coarse_generations) {
         scoring = &table;  // switch to the fine table: rescore the survivors on it
         for (auto& individual : population) evaluate(individual);
@@ -194,7 +220,7 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
     }
   }
 
-  polish(table, points, guess, &result);
+  polish(table, points, guess, effort.box, &result);
 
   if (population_out) {
     population_out->clear();
@@ -207,12 +233,11 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
 }
 
 void GeneticAligner::polish(const LookupTable& table, const FitnessPoints& points, const Pose2D& guess,
-                            PreAlignResult* result) const {
+                            const SearchBox& box, PreAlignResult* result) const {
   // Candidates stay inside the search box around the guess, like every GA individual.
   const auto inside_box = [&](const Pose2D& pose) {
-    return std::abs(pose.x - guess.x) <= options_.box.half_x &&
-           std::abs(pose.y - guess.y) <= options_.box.half_y &&
-           std::abs(normalizeAngle(pose.theta - guess.theta)) <= options_.box.half_theta;
+    return std::abs(pose.x - guess.x) <= box.half_x && std::abs(pose.y - guess.y) <= box.half_y &&
+           std::abs(normalizeAngle(pose.theta - guess.theta)) <= box.half_theta;
   };
   // Compass search: try +-step on each axis, move to the first improvement, halve the steps when none.
   const double cell = table.options().cell_size;

@@ -9,7 +9,8 @@ LookupTable::LookupTable(const LookupTableOptions& options) : options_(options) 
   // Guard against nonsense sizes here too; the ROS layer validates and names the parameter.
   if (!(options_.cell_size > 1e-4)) options_.cell_size = 0.02;
   if (!(options_.sigma > 0.0)) options_.sigma = 0.1;
-  if (!(options_.cutoff >= options_.cell_size)) options_.cutoff = std::max(options_.cell_size, 3 * options_.sigma);
+  if (!(options_.cutoff >= options_.cell_size))
+    options_.cutoff = std::max(options_.cell_size, 3 * options_.sigma);
   inv_cell_size_ = 1.0 / options_.cell_size;
   buildKernel();
 }
@@ -28,7 +29,8 @@ void LookupTable::buildKernel() {
       if (options_.kind == TableKind::kGraded) {
         const double distance = std::hypot(dx, dy) * options_.cell_size;
         if (distance <= options_.cutoff) {
-          value = static_cast<std::uint8_t>(std::lround(255.0 * std::exp(-distance * distance * inv_two_sigma_sq)));
+          value = static_cast<std::uint8_t>(
+              std::lround(255.0 * std::exp(-distance * distance * inv_two_sigma_sq)));
         }
       } else {
         value = 1;  // the whole square
@@ -45,6 +47,14 @@ std::size_t LookupTable::memoryBytes() const {
 }
 
 void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
+  ReferencePoints single;
+  single.append(reference);
+  build(single);
+}
+
+void LookupTable::build(const ReferencePoints& reference_set) {
+  const std::vector<Eigen::Vector2d>& reference = reference_set.points;
+  const std::vector<std::uint8_t> same_scan_as_next = reference_set.sameScanAsNext();
   tiles_in_use_ = 0;
   tiles_x_ = tiles_y_ = 0;
   tile_index_.clear();
@@ -58,7 +68,9 @@ void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
   samples_.clear();
   const double spacing = std::max(options_.cell_size, 0.5 * options_.sigma);
   const Eigen::Vector2d* previous = nullptr;
-  for (const auto& p : reference) {
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    const Eigen::Vector2d& p = reference[i];
+    if (i > 0 && !same_scan_as_next[i - 1]) previous = nullptr;  // never join two scans
     // Points beyond kMaxCoordinate get no cell (below); they must not be joined either: the joining gap
     // grows with the range, and two wild readings 1e30 m out would be joined by billions of samples.
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || std::abs(p.x()) > kMaxCoordinate ||
@@ -71,7 +83,8 @@ void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
       const double gap = (p - *previous).norm();
       if (gap < max_gap && gap > spacing) {
         const int pieces = static_cast<int>(std::ceil(gap / spacing));
-        for (int k = 1; k < pieces; ++k) samples_.push_back(*previous + (p - *previous) * (double(k) / pieces));
+        for (int k = 1; k < pieces; ++k)
+          samples_.push_back(*previous + (p - *previous) * (double(k) / pieces));
       }
     }
     samples_.push_back(p);
@@ -94,7 +107,9 @@ void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
 
   // Tile grid covering the box grown by the kernel radius; only touched tiles get cells.
   const long r = kernel_radius_;
-  const auto floor_div = [](long a) { return a >= 0 ? a >> kTileShift : -((-a + kTileSize - 1) >> kTileShift); };
+  const auto floor_div = [](long a) {
+    return a >= 0 ? a >> kTileShift : -((-a + kTileSize - 1) >> kTileShift);
+  };
   const long first_tile_x = floor_div(min_cx - r), last_tile_x = floor_div(max_cx + r);
   const long first_tile_y = floor_div(min_cy - r), last_tile_y = floor_div(max_cy + r);
   tiles_x_ = last_tile_x - first_tile_x + 1;
@@ -167,44 +182,24 @@ std::uint32_t LookupTable::fitness(const std::vector<Eigen::Vector2d>& points, c
 }
 
 std::uint32_t LookupTable::fitness(const FitnessPoints& points, const Pose2D& pose) const {
-  if (tiles_in_use_ == 0 || !pose.isFinite()) return 0;
-  // One transform and one byte read per point. The cell scaling is folded into the transform, which runs
-  // in blocks the compiler vectorises; coordinates are clamped to [-1, size] first (NaN -> -1), so the
-  // integer conversion is always defined and one unsigned comparison per axis is the bounds check.
-  const float c = static_cast<float>(std::cos(pose.theta) * inv_cell_size_);
-  const float s = static_cast<float>(std::sin(pose.theta) * inv_cell_size_);
-  const float ox = static_cast<float>(pose.x * inv_cell_size_ - origin_cell_x_);
-  const float oy = static_cast<float>(pose.y * inv_cell_size_ - origin_cell_y_);
-  const std::uint32_t width = static_cast<std::uint32_t>(tiles_x_ * kTileSize);
-  const std::uint32_t height = static_cast<std::uint32_t>(tiles_y_ * kTileSize);
-  const float max_x = static_cast<float>(width), max_y = static_cast<float>(height);
-  const std::int32_t* index = tile_index_.data();
-  const std::uint8_t* cells = tile_cells_.data();
-  const long tiles_x = tiles_x_;
-
-  constexpr std::size_t kBlock = 64;
-  std::int32_t cell_x[kBlock], cell_y[kBlock];
   std::uint32_t sum = 0;
-  const std::size_t n = points.size();
-  const float* px = points.x.data();
-  const float* py = points.y.data();
-  for (std::size_t begin = 0; begin < n; begin += kBlock) {
-    const std::size_t count = std::min(kBlock, n - begin);
-    for (std::size_t i = 0; i < count; ++i) {
-      const float fx = c * px[begin + i] - s * py[begin + i] + ox;
-      const float fy = s * px[begin + i] + c * py[begin + i] + oy;
-      cell_x[i] = static_cast<std::int32_t>(std::min(std::max(-1.0f, fx), max_x));
-      cell_y[i] = static_cast<std::int32_t>(std::min(std::max(-1.0f, fy), max_y));
-    }
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::uint32_t lx = static_cast<std::uint32_t>(cell_x[i]);
-      const std::uint32_t ly = static_cast<std::uint32_t>(cell_y[i]);
-      if (lx >= width || ly >= height) continue;
-      const std::int32_t tile = index[(ly >> kTileShift) * tiles_x + (lx >> kTileShift)];
-      if (tile < 0) continue;
-      sum += cells[static_cast<std::size_t>(tile) * kTileCells + ((ly & (kTileSize - 1)) << kTileShift) +
-                   (lx & (kTileSize - 1))];
-    }
+  forEachCell(points, pose, [&sum](std::uint8_t value) { sum += value; });
+  return sum;
+}
+
+double LookupTable::logLikelihood(const FitnessPoints& points, const Pose2D& pose, double outlier) const {
+  if (points.size() == 0) return 0.0;
+  std::uint32_t counts[256] = {};
+  std::uint32_t on_table = 0;
+  forEachCell(points, pose, [&](std::uint8_t value) {
+    ++counts[value];
+    ++on_table;
+  });
+  counts[0] += static_cast<std::uint32_t>(points.size()) - on_table;  // off the table: no reference near
+  const double max_value = static_cast<double>(maxCellValue());
+  double sum = 0.0;
+  for (int value = 0; value < 256; ++value) {
+    if (counts[value]) sum += counts[value] * std::log(outlier + value / max_value);
   }
   return sum;
 }

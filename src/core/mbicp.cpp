@@ -10,6 +10,15 @@ namespace {
 
 constexpr double kMinVariance = 1e-8;
 constexpr double kMaxVariance = 1e4;
+constexpr double kNoiseFloor = 1e-4;  // m^2: residuals never count as more precise than 1 cm
+
+/// d pose / d increment for pose' = increment * pose (the increment applied in the reference frame).
+Eigen::Matrix3d incrementToPose(const Pose2D& pose) {
+  Eigen::Matrix3d g = Eigen::Matrix3d::Identity();
+  g(0, 2) = -pose.y;
+  g(1, 2) = pose.x;
+  return g;
+}
 
 Eigen::Vector2d unitNormal(const Eigen::Vector2d& direction) {
   const double length = direction.norm();
@@ -39,10 +48,14 @@ Eigen::Matrix3d clampEigenvalues(const Eigen::Matrix3d& matrix, double low, doub
 
 const char* toString(MbicpStatus status) {
   switch (status) {
-    case MbicpStatus::kConverged: return "converged";
-    case MbicpStatus::kMaxIterations: return "max_iterations";
-    case MbicpStatus::kTooFewAssociations: return "too_few_associations";
-    case MbicpStatus::kDegenerate: return "degenerate";
+    case MbicpStatus::kConverged:
+      return "converged";
+    case MbicpStatus::kMaxIterations:
+      return "max_iterations";
+    case MbicpStatus::kTooFewAssociations:
+      return "too_few_associations";
+    case MbicpStatus::kDegenerate:
+      return "degenerate";
   }
   return "unknown";
 }
@@ -50,13 +63,31 @@ const char* toString(MbicpStatus status) {
 Mbicp::Mbicp(const MbicpOptions& options) : options_(options) {}
 
 void Mbicp::setReference(const Scan& reference) {
+  ReferencePoints single;
+  single.append(reference.points);
+  setReference(single);
+}
+
+void Mbicp::setReference(const ReferencePoints& reference) {
   ref_points_.clear();
-  for (const auto& p : reference.points) {
-    if (p.allFinite()) ref_points_.push_back(p);
+  // Which scan each kept point came from: segments never join two scans.
+  std::vector<std::size_t> scan_of_point;
+  const std::vector<std::uint8_t> same_scan_as_next = reference.sameScanAsNext();
+  std::size_t scan = 0;
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    if (reference.points[i].allFinite()) {
+      ref_points_.push_back(reference.points[i]);
+      scan_of_point.push_back(scan);
+    }
+    if (!same_scan_as_next[i]) ++scan;
   }
+  std::vector<std::uint8_t> same_scan(ref_points_.size(), 0);
+  for (std::size_t i = 0; i + 1 < ref_points_.size(); ++i)
+    same_scan[i] = scan_of_point[i] == scan_of_point[i + 1];
   const std::size_t n = ref_points_.size();
   ref_has_next_.assign(n, 0);
   for (std::size_t i = 0; i + 1 < n; ++i) {
+    if (!same_scan[i]) continue;
     const double range = std::min(ref_points_[i].norm(), ref_points_[i + 1].norm());
     const double max_gap = options_.segment_max_gap + options_.segment_gap_per_metre * range;
     ref_has_next_[i] = (ref_points_[i + 1] - ref_points_[i]).squaredNorm() < max_gap * max_gap ? 1 : 0;
@@ -77,12 +108,14 @@ void Mbicp::setReference(const Scan& reference) {
   std::iota(sorted_index_.begin(), sorted_index_.end(), 0);
   std::vector<double> bearing(n);
   for (std::size_t i = 0; i < n; ++i) bearing[i] = std::atan2(ref_points_[i].y(), ref_points_[i].x());
-  std::sort(sorted_index_.begin(), sorted_index_.end(), [&](int a, int b) { return bearing[a] < bearing[b]; });
+  std::sort(sorted_index_.begin(), sorted_index_.end(),
+            [&](int a, int b) { return bearing[a] < bearing[b]; });
   sorted_bearing_.resize(n);
   for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
 }
 
-void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) const {
+void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
+                      std::vector<Association>* out) const {
   out->clear();
   const double l_sq = options_.metric_l * options_.metric_l;
   const double gate_sq = gate * gate;
@@ -132,19 +165,21 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, st
     const double bearing = std::atan2(p.y(), p.x());
     const double range = p.norm();
     const int n = static_cast<int>(sorted_bearing_.size());
-    const int start = static_cast<int>(std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), bearing) -
-                                       sorted_bearing_.begin());
+    const int start = static_cast<int>(
+        std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), bearing) - sorted_bearing_.begin());
     double reach = window;
     double reach_best = -1.0;
     auto update_reach = [&]() {
-      // Smallest |d| whose bound reaches `best`: root of d^2 (L^2 - best) - 2 best |p| d - best (|p|^2 + L^2).
+      // Smallest |d| whose bound reaches `best`: root of d^2 (L^2 - best) - 2 best |p| d - best (|p|^2 +
+      // L^2).
       reach_best = best;
       const double denominator = l_sq - best;
       if (!(denominator > 0.0) || !(range > 0.0)) {
         reach = window;
         return;
       }
-      const double d_min = (best * range + std::sqrt(best * best * range * range + denominator * best * (range * range + l_sq))) /
+      const double d_min = (best * range + std::sqrt(best * best * range * range +
+                                                     denominator * best * (range * range + l_sq))) /
                            denominator;
       reach = d_min >= range ? window : std::min(window, std::asin(d_min / range));
     };
@@ -177,27 +212,28 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, st
   }
 }
 
-MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
+MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial, const PosePrior* prior) {
   MbicpResult result;
   result.pose = initial.isFinite() ? initial : Pose2D();
   result.covariance = Eigen::Matrix3d::Identity() * kMaxVariance;
+  if (prior && !(prior->mean.isFinite() && prior->information.allFinite())) prior = nullptr;
 
   std::vector<Eigen::Vector2d> points;
   points.reserve(scan.points.size());
   for (const auto& p : scan.points) {
     if (p.allFinite()) points.push_back(p);
   }
-  const std::size_t min_associations =
-      std::max<std::size_t>(3, static_cast<std::size_t>(std::ceil(options_.min_association_ratio * points.size())));
+  const std::size_t min_associations = std::max<std::size_t>(
+      3, static_cast<std::size_t>(std::ceil(options_.min_association_ratio * points.size())));
   if (ref_points_.empty() || points.size() < 3) {
     result.status = MbicpStatus::kTooFewAssociations;
     return result;
   }
 
-  const double l_sq = options_.metric_l * options_.metric_l;
   double previous_error = -1.0;
   int quiet_iterations = 0;
-  const double fine_gate = options_.fine_max_distance > 0.0 ? options_.fine_max_distance : options_.max_distance;
+  const double fine_gate =
+      options_.fine_max_distance > 0.0 ? options_.fine_max_distance : options_.max_distance;
   bool settled = fine_gate == options_.max_distance;
   Pose2D previous_pose, two_poses_ago;  // estimates of the last two settled iterations
   int settled_poses = 0;
@@ -217,50 +253,17 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
       result.associations = static_cast<int>(associations_.size());
       return result;
     }
-    // Trimming: the worst associations (outliers, unmatched structure) do not vote.
-    const std::size_t keep = std::max(
-        min_associations, static_cast<std::size_t>(std::ceil(options_.trim_fraction * associations_.size())));
-    if (keep < associations_.size()) {
-      std::nth_element(associations_.begin(), associations_.begin() + keep, associations_.end(),
-                       [](const Association& a, const Association& b) { return a.distance_sq < b.distance_sq; });
-      associations_.resize(keep);
-    }
-
-    // Closed-form step: minimise sum (r + J q)^T M (r + J q) over the increment q = (x, y, theta), with
-    // the point moved by the linearised rotation (J = [1 0 -p_y; 0 1 p_x]) and M the d_ap metric at the target.
-    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    Eigen::Vector3d step, scan_only_step;
     double error = 0.0;
-    for (const auto& assoc : associations_) {
-      const Eigen::Vector2d& p = assoc.point;
-      const Eigen::Vector2d& c = assoc.target;
-      const Eigen::Vector2d u(c.y(), -c.x());
-      Eigen::Matrix2d m = Eigen::Matrix2d::Identity() - u * u.transpose() / (c.squaredNorm() + l_sq);
-      // A point just past a segment's end point: point-to-point while the estimate moves (its pull along
-      // the surface helps turn a scan in from afar), then onto that end point's line (point-to-point would
-      // pull it towards the last reference beam: a rotation bias at every edge).
-      const bool line_residual = assoc.on_segment || (settled && !assoc.normal.isZero());
-      if (options_.point_to_line && line_residual) {
-        // Distance to the line under the metric: remove the metric-weighted tangent direction.
-        const Eigen::Vector2d tangent(assoc.normal.y(), -assoc.normal.x());
-        const Eigen::Vector2d m_tangent = m * tangent;
-        m -= m_tangent * m_tangent.transpose() / tangent.dot(m_tangent);
-      }
-      Eigen::Matrix<double, 2, 3> jacobian;
-      jacobian << 1.0, 0.0, -p.y(), 0.0, 1.0, p.x();
-      const Eigen::Matrix<double, 3, 2> jt_m = jacobian.transpose() * m;
-      a += jt_m * jacobian;
-      b += jt_m * (p - c);
-      error += assoc.distance_sq;
+    const bool solved =
+        solveStep(result.pose, settled, min_associations, prior, &step, &scan_only_step, &error);
+    if (scan_only_step.allFinite()) {
+      result.scan_only_pose =
+          Pose2D(scan_only_step.x(), scan_only_step.y(), scan_only_step.z()) * result.pose;
     }
-    error /= static_cast<double>(associations_.size());
     result.associations = static_cast<int>(associations_.size());
     result.rms_error = std::sqrt(error);
-
-    // A whisker of damping keeps directions no association constrains (a straight wall) at zero step.
-    a.diagonal() += Eigen::Vector3d::Constant(1e-9 * a.trace() + 1e-12);
-    const Eigen::Vector3d step = a.ldlt().solve(-b);
-    if (!step.allFinite()) {
+    if (!solved) {
       result.status = MbicpStatus::kDegenerate;
       break;
     }
@@ -268,7 +271,8 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
 
     if (!settled) {
       // Wide gate until the estimate settles; convergence is only judged under the fine gate.
-      settled = std::abs(step.x()) < options_.settle_step_xy && std::abs(step.y()) < options_.settle_step_xy &&
+      settled = std::abs(step.x()) < options_.settle_step_xy &&
+                std::abs(step.y()) < options_.settle_step_xy &&
                 std::abs(step.z()) < options_.settle_step_theta;
       previous_error = -1.0;
       continue;
@@ -278,8 +282,8 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
              std::abs(delta.theta) < options_.min_step_theta;
     };
     const bool small_step = within_min_step(Pose2D(step.x(), step.y(), step.z()));
-    const bool no_progress =
-        previous_error >= 0.0 && std::abs(previous_error - error) <= options_.error_ratio * std::max(error, 1e-12);
+    const bool no_progress = previous_error >= 0.0 && std::abs(previous_error - error) <=
+                                                          options_.error_ratio * std::max(error, 1e-12);
     // Back where it was two iterations ago: the associations flip between two sets (a point at the gate's
     // edge, or between an end point's line and a neighbouring segment) and neither step makes progress.
     const bool cycling = settled_poses >= 2 && within_min_step(result.pose * two_poses_ago.inverse());
@@ -294,6 +298,92 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
     }
   }
 
+  if (!prior) result.scan_only_pose = result.pose;
+  estimateUncertainty(prior, &result);
+  if (!result.pose.isFinite()) {
+    result.pose = initial.isFinite() ? initial : Pose2D();
+    result.status = MbicpStatus::kDegenerate;
+  }
+  return result;
+}
+
+double Mbicp::informationScale(std::size_t constraints) const {
+  if (!(options_.independent_points > 0.0) || constraints == 0) return 1.0;
+  return std::min(1.0, options_.independent_points / static_cast<double>(constraints));
+}
+
+bool Mbicp::solveStep(const Pose2D& pose, bool settled, std::size_t min_associations, const PosePrior* prior,
+                      Eigen::Vector3d* step, Eigen::Vector3d* scan_only_step, double* error) {
+  // Trimming: the worst associations (outliers, unmatched structure) do not vote.
+  const std::size_t keep = std::max(
+      min_associations, static_cast<std::size_t>(std::ceil(options_.trim_fraction * associations_.size())));
+  if (keep < associations_.size()) {
+    std::nth_element(
+        associations_.begin(), associations_.begin() + keep, associations_.end(),
+        [](const Association& a, const Association& b) { return a.distance_sq < b.distance_sq; });
+    associations_.resize(keep);
+  }
+
+  // Closed-form step: minimise sum (r + J q)^T M (r + J q) over the increment q = (x, y, theta), with
+  // the point moved by the linearised rotation (J = [1 0 -p_y; 0 1 p_x]) and M the d_ap metric at the target.
+  const double l_sq = options_.metric_l * options_.metric_l;
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  double error_sum = 0.0, residual_sq = 0.0;
+  for (const auto& assoc : associations_) {
+    const Eigen::Vector2d& p = assoc.point;
+    const Eigen::Vector2d& c = assoc.target;
+    const Eigen::Vector2d u(c.y(), -c.x());
+    Eigen::Matrix2d m = Eigen::Matrix2d::Identity() - u * u.transpose() / (c.squaredNorm() + l_sq);
+    // A point just past a segment's end point: point-to-point while the estimate moves (its pull along
+    // the surface helps turn a scan in from afar), then onto that end point's line (point-to-point would
+    // pull it towards the last reference beam: a rotation bias at every edge).
+    const bool line_residual =
+        options_.point_to_line && (assoc.on_segment || (settled && !assoc.normal.isZero()));
+    if (line_residual) {
+      // Distance to the line under the metric: remove the metric-weighted tangent direction.
+      const Eigen::Vector2d tangent(assoc.normal.y(), -assoc.normal.x());
+      const Eigen::Vector2d m_tangent = m * tangent;
+      m -= m_tangent * m_tangent.transpose() / tangent.dot(m_tangent);
+      const double r = assoc.normal.dot(p - c);
+      residual_sq += r * r;
+    } else {
+      residual_sq += assoc.distance_sq;
+    }
+    Eigen::Matrix<double, 2, 3> jacobian;
+    jacobian << 1.0, 0.0, -p.y(), 0.0, 1.0, p.x();
+    const Eigen::Matrix<double, 3, 2> jt_m = jacobian.transpose() * m;
+    a += jt_m * jacobian;
+    b += jt_m * (p - c);
+    error_sum += assoc.distance_sq;
+  }
+  const std::size_t count = associations_.size();
+  *error = error_sum / static_cast<double>(count);
+  // A whisker of damping keeps directions nothing constrains (a straight wall) at zero step.
+  const auto damped = [](Eigen::Matrix3d m) {
+    m.diagonal() += Eigen::Vector3d::Constant(1e-9 * m.trace() + 1e-12);
+    return m;
+  };
+  *scan_only_step = damped(a).ldlt().solve(-b);
+  if (prior) {
+    // MAP step: the residuals in units of their (calibrated) noise, plus the prior on the pose. The pose
+    // moves by G q for an increment q applied in the reference frame.
+    const double variance =
+        std::max(residual_sq / std::max<double>(1.0, static_cast<double>(count) - 3.0), kNoiseFloor);
+    const double weight = informationScale(count) / variance;
+    a *= weight;
+    b *= weight;
+    const Eigen::Matrix3d g = incrementToPose(pose);
+    const Eigen::Vector3d offset(pose.x - prior->mean.x, pose.y - prior->mean.y,
+                                 normalizeAngle(pose.theta - prior->mean.theta));
+    a += g.transpose() * prior->information * g;
+    b += g.transpose() * prior->information * offset;
+  }
+  *step = prior ? damped(a).ldlt().solve(-b) : *scan_only_step;
+  return step->allFinite();
+}
+
+void Mbicp::estimateUncertainty(const PosePrior* prior, MbicpResult* result) const {
   // Uncertainty from point-to-line information: only the component of each residual along the reference
   // normal is informative (a point may slide along a wall), so a corridor shows its unconstrained axis.
   Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
@@ -302,55 +392,62 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial) {
   for (const auto& assoc : associations_) {
     if (assoc.normal.isZero()) continue;
     const Eigen::Vector2d& p = assoc.point;  // in the reference frame, as the increments are
-    const Eigen::Vector3d row(assoc.normal.x(), assoc.normal.y(), assoc.normal.y() * p.x() - assoc.normal.x() * p.y());
+    const Eigen::Vector3d row(assoc.normal.x(), assoc.normal.y(),
+                              assoc.normal.y() * p.x() - assoc.normal.x() * p.y());
     information += row * row.transpose();
     const double r = assoc.normal.dot(assoc.point - assoc.target);
     residual_sq += r * r;
     ++constraints;
   }
-  if (constraints > 3) {
-    // Noise floor of 1 cm: residuals of a noise-free or perfectly interleaved pair are not zero-uncertainty.
-    const double variance = std::max(residual_sq / (constraints - 3), 1e-4);
-    // Degeneracy test in consistent units: scale the rotation by the mean point radius.
-    double radius = 0.0;
-    for (const auto& assoc : associations_) radius += assoc.point.norm();
-    radius = std::max(radius / associations_.size(), 1e-3);
-    Eigen::Matrix3d scaled = information;
-    scaled.row(2) /= radius;
-    scaled.col(2) /= radius;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scaled);
-    const Eigen::Vector3d eigenvalues = solver.eigenvalues();
-    // The information is of an increment applied in the reference frame (pose = delta * estimate);
-    // G maps that increment to the pose's own (x, y, theta).
-    Eigen::Matrix3d to_pose = Eigen::Matrix3d::Identity();
-    to_pose(0, 2) = -result.pose.y;
-    to_pose(1, 2) = result.pose.x;
-    const bool degenerate = !(eigenvalues.minCoeff() > options_.degenerate_eigenvalue * eigenvalues.maxCoeff());
-    if (degenerate) {
-      result.status = MbicpStatus::kDegenerate;
-      // Pseudo-inverse of the scaled information: the unconstrained direction gets the maximum variance.
-      Eigen::Vector3d inverse_eigen;
-      for (int i = 0; i < 3; ++i) {
-        inverse_eigen[i] = eigenvalues[i] > options_.degenerate_eigenvalue * eigenvalues.maxCoeff()
-                               ? variance / eigenvalues[i]
-                               : kMaxVariance;
-      }
-      Eigen::Matrix3d cov_scaled = solver.eigenvectors() * inverse_eigen.asDiagonal() * solver.eigenvectors().transpose();
-      cov_scaled.row(2) /= radius;
-      cov_scaled.col(2) /= radius;
-      result.covariance = clampEigenvalues(to_pose * cov_scaled * to_pose.transpose(), kMinVariance, kMaxVariance);
-    } else {
-      result.covariance = clampEigenvalues(to_pose * (variance * information.inverse()) * to_pose.transpose(),
-                                           kMinVariance, kMaxVariance);
+  if (constraints <= 3) {
+    if (!prior) {
+      result->status = MbicpStatus::kTooFewAssociations;
+      return;
     }
+    result->degenerate = true;
+    result->covariance = clampEigenvalues(prior->information.inverse(), kMinVariance, kMaxVariance);
+    return;
+  }
+  // Noise floor of 1 cm: residuals of a noise-free or perfectly interleaved pair are not zero-uncertainty.
+  const double variance =
+      std::max(residual_sq / (constraints - 3), kNoiseFloor) / informationScale(constraints);
+  // Degeneracy test in consistent units: scale the rotation by the mean point radius.
+  double radius = 0.0;
+  for (const auto& assoc : associations_) radius += assoc.point.norm();
+  radius = std::max(radius / associations_.size(), 1e-3);
+  Eigen::Matrix3d scaled = information;
+  scaled.row(2) /= radius;
+  scaled.col(2) /= radius;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scaled);
+  const Eigen::Vector3d eigenvalues = solver.eigenvalues();
+  const double threshold = options_.degenerate_eigenvalue * eigenvalues.maxCoeff();
+  result->degenerate = !(eigenvalues.minCoeff() > threshold);
+
+  // The information is of an increment applied in the reference frame (pose = delta * estimate);
+  // G maps that increment to the pose's own (x, y, theta).
+  const Eigen::Matrix3d to_pose = incrementToPose(result->pose);
+  const Eigen::Matrix3d from_pose = to_pose.inverse();
+  result->scan_information = from_pose.transpose() * (information / variance) * from_pose;
+  if (prior) {
+    const Eigen::Matrix3d posterior = result->scan_information + prior->information;
+    result->covariance = clampEigenvalues(posterior.inverse(), kMinVariance, kMaxVariance);
+  } else if (result->degenerate) {
+    result->status = MbicpStatus::kDegenerate;
+    // Pseudo-inverse of the scaled information: the unconstrained direction gets the maximum variance.
+    Eigen::Vector3d inverse_eigen;
+    for (int i = 0; i < 3; ++i) {
+      inverse_eigen[i] = eigenvalues[i] > threshold ? variance / eigenvalues[i] : kMaxVariance;
+    }
+    Eigen::Matrix3d cov_scaled =
+        solver.eigenvectors() * inverse_eigen.asDiagonal() * solver.eigenvectors().transpose();
+    cov_scaled.row(2) /= radius;
+    cov_scaled.col(2) /= radius;
+    result->covariance =
+        clampEigenvalues(to_pose * cov_scaled * to_pose.transpose(), kMinVariance, kMaxVariance);
   } else {
-    result.status = MbicpStatus::kTooFewAssociations;
+    result->covariance = clampEigenvalues(to_pose * (variance * information.inverse()) * to_pose.transpose(),
+                                          kMinVariance, kMaxVariance);
   }
-  if (!result.pose.isFinite()) {
-    result.pose = initial.isFinite() ? initial : Pose2D();
-    result.status = MbicpStatus::kDegenerate;
-  }
-  return result;
 }
 
 }  // namespace hglasm

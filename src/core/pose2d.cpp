@@ -6,7 +6,7 @@ double normalizeAngle(double angle) {
   if (!std::isfinite(angle)) return angle;
   if (angle > -M_PI && angle <= M_PI) return angle;
   double wrapped = std::fmod(angle + M_PI, 2.0 * M_PI);  // (-2pi, 2pi)
-  if (wrapped <= 0.0) wrapped += 2.0 * M_PI;               // (0, 2pi]
+  if (wrapped <= 0.0) wrapped += 2.0 * M_PI;             // (0, 2pi]
   return wrapped - M_PI;
 }
 
@@ -39,6 +39,19 @@ Eigen::Matrix3d adjoint(const Pose2D& pose) {
       s, c, -pose.x,    //
       0, 0, 1;
   return ad;
+}
+
+Eigen::Matrix3d composeCovariance(const Pose2D& a, const Eigen::Matrix3d& cov_a, const Pose2D& b,
+                                  const Eigen::Matrix3d& cov_b) {
+  const Pose2D ab = a * b;
+  Eigen::Matrix3d j_a = Eigen::Matrix3d::Identity();
+  j_a(0, 2) = -(ab.y - a.y);
+  j_a(1, 2) = ab.x - a.x;
+  Eigen::Matrix3d j_b = Eigen::Matrix3d::Identity();
+  const double c = std::cos(a.theta), s = std::sin(a.theta);
+  j_b.topLeftCorner<2, 2>() << c, -s, s, c;
+  const Eigen::Matrix3d covariance = j_a * cov_a * j_a.transpose() + j_b * cov_b * j_b.transpose();
+  return 0.5 * (covariance + covariance.transpose());
 }
 
 }  // namespace hglasm

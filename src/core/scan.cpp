@@ -7,10 +7,14 @@ namespace hglasm {
 
 const char* toString(ScanError error) {
   switch (error) {
-    case ScanError::kNone: return "ok";
-    case ScanError::kNoBeams: return "scan has no beams";
-    case ScanError::kBadAngles: return "angle_min or angle_increment is not finite, or the increment is zero";
-    case ScanError::kBadRangeLimits: return "range_min/range_max are NaN or range_max < range_min";
+    case ScanError::kNone:
+      return "ok";
+    case ScanError::kNoBeams:
+      return "scan has no beams";
+    case ScanError::kBadAngles:
+      return "angle_min or angle_increment is not finite, or the increment is zero";
+    case ScanError::kBadRangeLimits:
+      return "range_min/range_max are NaN or range_max < range_min";
   }
   return "unknown";
 }
@@ -24,7 +28,8 @@ Scan scanFromRanges(const RangeScan& input, const ScanConversionOptions& options
   } else if (!std::isfinite(input.angle_min) || !std::isfinite(input.angle_increment) ||
              (input.ranges.size() > 1 && input.angle_increment == 0.0)) {
     status = ScanError::kBadAngles;
-  } else if (std::isnan(input.range_min) || std::isnan(input.range_max) || input.range_max < input.range_min) {
+  } else if (std::isnan(input.range_min) || std::isnan(input.range_max) ||
+             input.range_max < input.range_min) {
     status = ScanError::kBadRangeLimits;
   }
   if (error) *error = status;
@@ -57,6 +62,22 @@ Scan scanFromRanges(const RangeScan& input, const ScanConversionOptions& options
     scan.time_increment = options.sweep_time / (scan.beam_count - 1);
   }
   return scan;
+}
+
+void ReferencePoints::append(const std::vector<Eigen::Vector2d>& scan_points, const Pose2D& pose) {
+  if (scan_points.empty()) return;
+  scan_starts.push_back(points.size());
+  points.reserve(points.size() + scan_points.size());
+  for (const auto& point : scan_points) points.push_back(pose * point);
+}
+
+std::vector<std::uint8_t> ReferencePoints::sameScanAsNext() const {
+  std::vector<std::uint8_t> same(points.size(), 1);
+  if (!points.empty()) same.back() = 0;
+  for (const std::size_t start : scan_starts) {
+    if (start > 0 && start <= points.size()) same[start - 1] = 0;
+  }
+  return same;
 }
 
 Scan selectBeams(const Scan& scan, int parity) {

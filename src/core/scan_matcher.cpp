@@ -12,7 +12,7 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
 
 TableKind tableKindOf(Algorithm algorithm) {
   return algorithm == Algorithm::kHglasmBinary || algorithm == Algorithm::kGlasmBinary ? TableKind::kBinary
-                                                                                         : TableKind::kGraded;
+                                                                                       : TableKind::kGraded;
 }
 
 LookupTableOptions tableOptionsFor(const LookupTableOptions& base, Algorithm algorithm) {
@@ -25,11 +25,16 @@ LookupTableOptions tableOptionsFor(const LookupTableOptions& base, Algorithm alg
 
 const char* toString(Algorithm algorithm) {
   switch (algorithm) {
-    case Algorithm::kHglasmG: return "hglasm_g";
-    case Algorithm::kHglasmBinary: return "hglasm_binary";
-    case Algorithm::kGlasmG: return "glasm_g";
-    case Algorithm::kGlasmBinary: return "glasm_binary";
-    case Algorithm::kMbicp: return "mbicp";
+    case Algorithm::kHglasmG:
+      return "hglasm_g";
+    case Algorithm::kHglasmBinary:
+      return "hglasm_binary";
+    case Algorithm::kGlasmG:
+      return "glasm_g";
+    case Algorithm::kGlasmBinary:
+      return "glasm_binary";
+    case Algorithm::kMbicp:
+      return "mbicp";
   }
   return "unknown";
 }
@@ -47,14 +52,18 @@ bool parseAlgorithm(const std::string& name, Algorithm* algorithm) {
 
 bool usesGeneticStage(Algorithm algorithm) { return algorithm != Algorithm::kMbicp; }
 bool usesMbicpStage(Algorithm algorithm) {
-  return algorithm == Algorithm::kHglasmG || algorithm == Algorithm::kHglasmBinary || algorithm == Algorithm::kMbicp;
+  return algorithm == Algorithm::kHglasmG || algorithm == Algorithm::kHglasmBinary ||
+         algorithm == Algorithm::kMbicp;
 }
 
 const char* toString(Preset preset) {
   switch (preset) {
-    case Preset::kSmall: return "small";
-    case Preset::kMedium: return "medium";
-    case Preset::kLarge: return "large";
+    case Preset::kSmall:
+      return "small";
+    case Preset::kMedium:
+      return "medium";
+    case Preset::kLarge:
+      return "large";
   }
   return "unknown";
 }
@@ -118,12 +127,18 @@ MatcherOptions presetOptions(Preset preset) {
 
 const char* toString(MatchStatus status) {
   switch (status) {
-    case MatchStatus::kOk: return "ok";
-    case MatchStatus::kNoReference: return "no_reference";
-    case MatchStatus::kTooFewPoints: return "too_few_points";
-    case MatchStatus::kLowFitness: return "low_fitness";
-    case MatchStatus::kMbicpFailed: return "mbicp_failed";
-    case MatchStatus::kMbicpNotConverged: return "mbicp_not_converged";
+    case MatchStatus::kOk:
+      return "ok";
+    case MatchStatus::kNoReference:
+      return "no_reference";
+    case MatchStatus::kTooFewPoints:
+      return "too_few_points";
+    case MatchStatus::kLowFitness:
+      return "low_fitness";
+    case MatchStatus::kMbicpFailed:
+      return "mbicp_failed";
+    case MatchStatus::kMbicpNotConverged:
+      return "mbicp_not_converged";
   }
   return "unknown";
 }
@@ -136,10 +151,17 @@ ScanMatcher::ScanMatcher(const MatcherOptions& options)
       mbicp_(options.mbicp) {}
 
 void ScanMatcher::setReference(const Scan& reference) {
+  ReferencePoints single;
+  single.append(reference.points);
+  setReference(single);
+}
+
+void ScanMatcher::setReference(const ReferencePoints& reference) {
   const auto start = std::chrono::steady_clock::now();
   if (usesGeneticStage(options_.algorithm)) {
-    table_.build(reference.points);
-    if (options_.genetic.coarse_generations > 0) coarse_table_.build(reference.points);
+    table_.build(reference);
+    reference_ = reference;
+    coarse_table_stale_ = true;
   }
   table_build_ms_ = millisecondsSince(start);
   mbicp_.setReference(reference);
@@ -161,14 +183,21 @@ bool ScanMatcher::startResult(const Scan& scan, const Pose2D& guess, MatchResult
   return true;
 }
 
-MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vector<Pose2D>* population_out) {
+MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vector<Pose2D>* population_out,
+                               const SearchEffort* effort, const PosePrior* prior) {
   MatchResult result;
   if (!startResult(scan, guess, &result)) return result;
   const Pose2D start_pose = result.pose;
 
   if (usesGeneticStage(options_.algorithm)) {
     const auto start = std::chrono::steady_clock::now();
-    const PreAlignResult prealigned = aligner_.align(table_, scan.points, start_pose, population_out, &coarse_table_);
+    const int coarse_generations = effort ? effort->coarse_generations : options_.genetic.coarse_generations;
+    if (coarse_generations > 0 && coarse_table_stale_) {
+      coarse_table_.build(reference_);
+      coarse_table_stale_ = false;
+    }
+    const PreAlignResult prealigned =
+        aligner_.align(table_, scan.points, start_pose, population_out, &coarse_table_, effort);
     result.prealign_ms = millisecondsSince(start);
     result.prealigned_pose = result.pose = prealigned.pose;
     result.fitness = prealigned.fitness;
@@ -183,7 +212,7 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
     }
   }
 
-  refineInto(scan, &result);
+  refineInto(scan, prior, &result);
   if (!usesGeneticStage(options_.algorithm) && table_.empty()) {
     // MbICP alone: report the fraction of points associated as the quality ratio.
     result.fitness_ratio = static_cast<double>(result.associations) / static_cast<double>(scan.size());
@@ -191,9 +220,9 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
   return result;
 }
 
-void ScanMatcher::refineInto(const Scan& scan, MatchResult* result) {
+void ScanMatcher::refineInto(const Scan& scan, const PosePrior* prior, MatchResult* result) {
   const auto start = std::chrono::steady_clock::now();
-  const MbicpResult refined = mbicp_.match(scan, result->prealigned_pose);
+  const MbicpResult refined = mbicp_.match(scan, result->prealigned_pose, prior);
   result->refine_ms = millisecondsSince(start);
   result->pose = refined.pose;
   result->iterations = refined.iterations;
@@ -201,18 +230,27 @@ void ScanMatcher::refineInto(const Scan& scan, MatchResult* result) {
   result->rms_error = refined.rms_error;
   result->mbicp_status = refined.status;
   result->covariance = refined.covariance;
+  result->scan_information = refined.scan_information;
+  result->degenerate = refined.degenerate;
+  result->scan_only_pose = refined.scan_only_pose;
   switch (refined.status) {
-    case MbicpStatus::kConverged: result->status = MatchStatus::kOk; break;
-    case MbicpStatus::kMaxIterations: result->status = MatchStatus::kMbicpNotConverged; break;
+    case MbicpStatus::kConverged:
+      result->status = MatchStatus::kOk;
+      break;
+    case MbicpStatus::kMaxIterations:
+      result->status = MatchStatus::kMbicpNotConverged;
+      break;
     case MbicpStatus::kTooFewAssociations:
-    case MbicpStatus::kDegenerate: result->status = MatchStatus::kMbicpFailed; break;
+    case MbicpStatus::kDegenerate:
+      result->status = MatchStatus::kMbicpFailed;
+      break;
   }
 }
 
-MatchResult ScanMatcher::refine(const Scan& scan, const Pose2D& guess) {
+MatchResult ScanMatcher::refine(const Scan& scan, const Pose2D& guess, const PosePrior* prior) {
   MatchResult result;
   if (!startResult(scan, guess, &result)) return result;
-  refineInto(scan, &result);
+  refineInto(scan, prior, &result);
   result.fitness_ratio = fitnessRatioAt(scan, result.pose);
   return result;
 }
@@ -221,6 +259,13 @@ double ScanMatcher::fitnessRatioAt(const Scan& scan, const Pose2D& pose) const {
   if (table_.empty() || scan.empty()) return 0.0;
   const double best = static_cast<double>(table_.maxCellValue()) * static_cast<double>(scan.size());
   return table_.fitness(scan.points, pose) / best;
+}
+
+double ScanMatcher::logLikelihoodAt(const Scan& scan, const Pose2D& pose, double outlier) const {
+  if (table_.empty() || scan.empty()) return 0.0;
+  FitnessPoints points;
+  points.assign(scan.points);
+  return table_.logLikelihood(points, pose, outlier);
 }
 
 }  // namespace hglasm

@@ -22,12 +22,12 @@ struct GeneticOptions {
   SearchBox box;
   int population = 20;
   int generations = 6;
-  int runs = 1;                ///< independent GA runs; the best result wins
-  int bits_per_gene = 9;       ///< Gray-coded resolution of x, y and theta over the box
+  int runs = 1;           ///< independent GA runs; the best result wins
+  int bits_per_gene = 9;  ///< Gray-coded resolution of x, y and theta over the box
   double crossover_rate = 0.8;
   double mutation_rate = 0.03;  ///< per bit
   int tournament_size = 2;
-  int elite_count = 1;          ///< best individuals copied unchanged into the next generation
+  int elite_count = 1;  ///< best individuals copied unchanged into the next generation
   /// Fitness uses at most this many of the new scan's points, evenly spread over the scan (0 = all):
   /// the coarse search does not need every beam, and its cost is linear in the points.
   int max_points = 0;
@@ -41,11 +41,23 @@ struct GeneticOptions {
   std::uint64_t seed = 1;
 };
 
+/// How widely and how hard one alignment searches: the papers' Table 1 grows the box and the GA together.
+struct SearchEffort {
+  SearchBox box;
+  int population = 20;
+  int generations = 6;
+  int runs = 1;
+  int coarse_generations = 0;
+};
+
+/// The effort of `options` itself (its box and GA size).
+SearchEffort effortOf(const GeneticOptions& options);
+
 struct PreAlignResult {
-  Pose2D pose;                    ///< best pose found (new scan in the reference frame)
-  std::uint32_t fitness = 0;      ///< its fitness
-  double fitness_ratio = 0.0;     ///< fitness / (max cell value * points): 1 = every point on a reference point
-  int evaluations = 0;  ///< fitness evaluations: 1 (guess) + population * generations * runs + polish
+  Pose2D pose;                 ///< best pose found (new scan in the reference frame)
+  std::uint32_t fitness = 0;   ///< its fitness
+  double fitness_ratio = 0.0;  ///< fitness / (max cell value * points): 1 = every point on a reference point
+  int evaluations = 0;         ///< fitness evaluations: 1 (guess) + population * generations * runs + polish
 };
 
 /// Not thread-safe per instance (it owns its random generator); separate instances are independent.
@@ -55,10 +67,11 @@ class GeneticAligner {
 
   /// Searches the box around `guess` for the pose maximising table.fitness(points, pose).
   /// If `population_out` is given it receives the final population of the best run (for display).
-  /// `coarse_table` (optional) is used for the first options().coarse_generations generations.
+  /// `coarse_table` (optional) is used for the first coarse_generations generations. `effort` (optional)
+  /// replaces the box and GA size of the options for this call.
   PreAlignResult align(const LookupTable& table, const std::vector<Eigen::Vector2d>& points,
                        const Pose2D& guess, std::vector<Pose2D>* population_out = nullptr,
-                       const LookupTable* coarse_table = nullptr);
+                       const LookupTable* coarse_table = nullptr, const SearchEffort* effort = nullptr);
 
   /// Restarts the random sequence (same seed -> same results).
   void reseed(std::uint64_t seed) { rng_.seed(seed); }
@@ -67,7 +80,7 @@ class GeneticAligner {
 
  private:
   void polish(const LookupTable& table, const FitnessPoints& points, const Pose2D& guess,
-              PreAlignResult* result) const;
+              const SearchBox& box, PreAlignResult* result) const;
 
   GeneticOptions options_;
   std::mt19937_64 rng_;

@@ -2,11 +2,14 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "hglasm_odometry/core/pose2d.h"
+#include "hglasm_odometry/core/scan.h"
 
 namespace hglasm {
 
@@ -45,6 +48,13 @@ class LookupTable {
   /// Rebuilds the table for new reference points given in beam order (reusing memory). Non-finite points
   /// are ignored.
   void build(const std::vector<Eigen::Vector2d>& reference);
+  /// The same for several scans in one frame (a local map): gaps are joined within a scan only.
+  void build(const ReferencePoints& reference);
+
+  /// Log-likelihood of `points` moved by `pose` under the table read as a likelihood field: each point
+  /// scores log(outlier + cell / maxCell), a normal of its distance to the reference mixed with a uniform
+  /// outlier density, so points far from any reference point cost a bounded amount.
+  double logLikelihood(const FitnessPoints& points, const Pose2D& pose, double outlier) const;
 
   /// Cell value at a point in the reference frame; 0 outside the table.
   std::uint8_t valueAt(const Eigen::Vector2d& point) const;
@@ -71,6 +81,48 @@ class LookupTable {
 
   void buildKernel();
 
+  /// Calls f(cell value) for every point of `points` moved by `pose` that lands on an allocated tile.
+  /// One transform and one byte read per point: the cell scaling is folded into the transform, which runs
+  /// in blocks the compiler vectorises; coordinates are clamped to [-1, size] first (NaN -> -1), so the
+  /// integer conversion is always defined and one unsigned comparison per axis is the bounds check.
+  template <typename F>
+  void forEachCell(const FitnessPoints& points, const Pose2D& pose, F&& f) const {
+    if (tiles_in_use_ == 0 || !pose.isFinite()) return;
+    const float c = static_cast<float>(std::cos(pose.theta) * inv_cell_size_);
+    const float s = static_cast<float>(std::sin(pose.theta) * inv_cell_size_);
+    const float ox = static_cast<float>(pose.x * inv_cell_size_ - origin_cell_x_);
+    const float oy = static_cast<float>(pose.y * inv_cell_size_ - origin_cell_y_);
+    const std::uint32_t width = static_cast<std::uint32_t>(tiles_x_ * kTileSize);
+    const std::uint32_t height = static_cast<std::uint32_t>(tiles_y_ * kTileSize);
+    const float max_x = static_cast<float>(width), max_y = static_cast<float>(height);
+    const std::int32_t* index = tile_index_.data();
+    const std::uint8_t* cells = tile_cells_.data();
+    const long tiles_x = tiles_x_;
+    constexpr std::size_t kBlock = 64;
+    std::int32_t cell_x[kBlock], cell_y[kBlock];
+    const std::size_t n = points.size();
+    const float* px = points.x.data();
+    const float* py = points.y.data();
+    for (std::size_t begin = 0; begin < n; begin += kBlock) {
+      const std::size_t count = std::min(kBlock, n - begin);
+      for (std::size_t i = 0; i < count; ++i) {
+        const float fx = c * px[begin + i] - s * py[begin + i] + ox;
+        const float fy = s * px[begin + i] + c * py[begin + i] + oy;
+        cell_x[i] = static_cast<std::int32_t>(std::min(std::max(-1.0f, fx), max_x));
+        cell_y[i] = static_cast<std::int32_t>(std::min(std::max(-1.0f, fy), max_y));
+      }
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t lx = static_cast<std::uint32_t>(cell_x[i]);
+        const std::uint32_t ly = static_cast<std::uint32_t>(cell_y[i]);
+        if (lx >= width || ly >= height) continue;
+        const std::int32_t tile = index[(ly >> kTileShift) * tiles_x + (lx >> kTileShift)];
+        if (tile < 0) continue;
+        f(cells[static_cast<std::size_t>(tile) * kTileCells + ((ly & (kTileSize - 1)) << kTileShift) +
+                (lx & (kTileSize - 1))]);
+      }
+    }
+  }
+
   LookupTableOptions options_;
   double inv_cell_size_ = 0.0;
   long origin_cell_x_ = 0;  // global cell coordinates of the first cell of tile_index_[0]
@@ -80,7 +132,7 @@ class LookupTable {
   std::vector<std::int32_t> tile_index_;  // tiles_x_ * tiles_y_, -1 = no tile
   std::vector<std::uint8_t> tile_cells_;  // tiles_in_use_ * kTileCells
   std::size_t tiles_in_use_ = 0;
-  std::vector<Eigen::Vector2d> samples_;   // scratch: stamp centres
+  std::vector<Eigen::Vector2d> samples_;  // scratch: stamp centres
   std::vector<std::uint8_t> kernel_;      // (2r+1)^2 stamp, r = ceil(cutoff / cell_size)
   int kernel_radius_ = 0;
 };

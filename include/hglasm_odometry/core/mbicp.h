@@ -11,47 +11,69 @@
 namespace hglasm {
 
 struct MbicpOptions {
-  double metric_l = 3.0;              ///< L of the metric, metres
-  double bearing_window = 0.52;       ///< radians: candidate reference points lie within this bearing
-  double max_distance = 0.30;         ///< metres: association gate on d_ap while the estimate moves
+  double metric_l = 3.0;         ///< L of the metric, metres
+  double bearing_window = 0.52;  ///< radians: candidate reference points lie within this bearing
+  double max_distance = 0.30;    ///< metres: association gate on d_ap while the estimate moves
   /// metres: the gate once steps fall below settle_step_xy / settle_step_theta (the estimate has settled):
   /// the last iterations ignore moved objects and unmatched structure. <= 0: keep max_distance.
   double fine_max_distance = 0.15;
-  double settle_step_xy = 0.01;       ///< metres
-  double settle_step_theta = 0.005;   ///< radians
+  double settle_step_xy = 0.01;      ///< metres
+  double settle_step_theta = 0.005;  ///< radians
   /// Consecutive reference points form a segment if they are closer than
   /// segment_max_gap + segment_gap_per_metre * range (beams diverge with range).
-  double segment_max_gap = 0.30;      ///< metres
+  double segment_max_gap = 0.30;  ///< metres
   double segment_gap_per_metre = 0.10;
-  double trim_fraction = 0.95;        ///< keep this fraction of the best associations
+  double trim_fraction = 0.95;  ///< keep this fraction of the best associations
   int max_iterations = 50;
-  double error_ratio = 1e-4;          ///< |E_k - E_k-1| / E_k below this counts as no progress
-  double min_step_xy = 1e-4;          ///< metres: a step smaller than this counts as no progress
-  double min_step_theta = 1e-4;       ///< radians
-  int converged_iterations = 2;       ///< consecutive no-progress iterations to stop
-  double min_association_ratio = 0.1; ///< fail below this fraction of the new scan associated
+  double error_ratio = 1e-4;            ///< |E_k - E_k-1| / E_k below this counts as no progress
+  double min_step_xy = 1e-4;            ///< metres: a step smaller than this counts as no progress
+  double min_step_theta = 1e-4;         ///< radians
+  int converged_iterations = 2;         ///< consecutive no-progress iterations to stop
+  double min_association_ratio = 0.1;   ///< fail below this fraction of the new scan associated
   double degenerate_eigenvalue = 1e-6;  ///< relative: min/max eigenvalue of the normal equations
   /// M-step residual of a point associated with a reference segment (or, once settled, a segment's end
   /// point): true = its d_ap distance to the segment's line (the metric restricted to the normal; converges
   /// in a few iterations like PL-ICP), false = its d_ap distance to the closest point, as in the original
   /// MbICP (slower, linear convergence). Isolated reference points are always point-to-point.
   bool point_to_line = true;
+  /// The scan's information is that of at most this many independent points. Neighbouring laser points
+  /// share their errors (a wall's range bias, the reference's own noise, a moved object), so n points do
+  /// not know n times more than one: sigma^2 H^-1 over hundreds of points is far too confident. Measured
+  /// against the relations of the Freiburg logs (README); 0 = every point independent (sigma^2 H^-1).
+  double independent_points = 0.0;
+};
+
+/// A Gaussian belief about the pose being estimated (the new scan in the reference frame), e.g. the
+/// motion predicted by wheel odometry: MbICP then finds the maximum a posteriori pose of scan and prior.
+struct PosePrior {
+  Pose2D mean;
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();  ///< inverse covariance of (x, y, theta)
 };
 
 enum class MbicpStatus { kConverged, kMaxIterations, kTooFewAssociations, kDegenerate };
 const char* toString(MbicpStatus status);
 
 struct MbicpResult {
-  Pose2D pose;                         ///< new scan's pose in the reference frame
+  Pose2D pose;  ///< new scan's pose in the reference frame
   MbicpStatus status = MbicpStatus::kTooFewAssociations;
   int iterations = 0;
-  int associations = 0;                ///< associations kept (after trimming) in the last iteration
-  double rms_error = 0.0;              ///< metres, sqrt(mean d_ap^2) of kept associations
+  int associations = 0;    ///< associations kept (after trimming) in the last iteration
+  double rms_error = 0.0;  ///< metres, sqrt(mean d_ap^2) of kept associations
   /// 3x3 covariance of (x, y, theta) at the final pose: sigma^2 * H^-1, where H is the point-to-line
   /// information of the final associations (each residual projected on the reference surface normal, so
   /// sliding along a featureless corridor shows as a large variance) and sigma^2 their residual variance.
-  /// Eigenvalues are clamped to [1e-8, 1e4]: always finite and positive definite.
+  /// Eigenvalues are clamped to [1e-8, 1e4]: always finite and positive definite. With a prior, the
+  /// covariance of the posterior (scan and prior).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  /// Information of the scan alone about (x, y, theta) at the final pose, calibrated (independent_points);
+  /// singular along directions the scene does not constrain (a corridor's axis).
+  Eigen::Matrix3d scan_information = Eigen::Matrix3d::Zero();
+  /// With a prior: where the scan alone would have put the pose (one scan-only step from the last
+  /// iterate, on the final associations); equal to `pose` without a prior.
+  Pose2D scan_only_pose;
+  /// The scan alone leaves a direction unconstrained. Without a prior the status is then kDegenerate; with
+  /// one the prior decides that direction and the status says whether the iterations converged.
+  bool degenerate = false;
 };
 
 /// Holds the reference scan's search structure; match() may be called many times per reference.
@@ -61,10 +83,13 @@ class Mbicp {
   explicit Mbicp(const MbicpOptions& options = {});
 
   void setReference(const Scan& reference);
+  /// Several scans in one frame (a local map): segments join consecutive points of one scan only.
+  void setReference(const ReferencePoints& reference);
   bool hasReference() const { return !ref_points_.empty(); }
 
-  /// Refines `initial` (new scan in the reference frame). Always returns finite numbers.
-  MbicpResult match(const Scan& scan, const Pose2D& initial);
+  /// Refines `initial` (new scan in the reference frame). With a `prior` the result is the maximum a
+  /// posteriori pose (scan residuals weighted by their calibrated information). Always finite numbers.
+  MbicpResult match(const Scan& scan, const Pose2D& initial, const PosePrior* prior = nullptr);
 
   const MbicpOptions& options() const { return options_; }
 
@@ -77,15 +102,23 @@ class Mbicp {
     double distance_sq;      // d_ap^2
   };
   void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) const;
+  /// Trims the worst associations and solves for the increment (pose = increment * pose); false if the
+  /// system has no finite solution.
+  bool solveStep(const Pose2D& pose, bool settled, std::size_t min_associations, const PosePrior* prior,
+                 Eigen::Vector3d* step, Eigen::Vector3d* scan_only_step, double* error);
+  /// Covariance, calibrated scan information and degeneracy at the final pose from the final associations.
+  void estimateUncertainty(const PosePrior* prior, MbicpResult* result) const;
+  /// Share of the information of `constraints` associations that counts (independent_points).
+  double informationScale(std::size_t constraints) const;
 
   MbicpOptions options_;
-  std::vector<Eigen::Vector2d> ref_points_;  // in beam order
-  std::vector<std::int8_t> ref_has_next_;    // segment from point i to i+1
-  std::vector<Eigen::Vector2d> ref_normals_; // unit surface normal at each point (zero if isolated)
-  std::vector<double> sorted_bearing_;       // bearings of reference points, ascending
-  std::vector<int> sorted_index_;            // their indices into ref_points_
-  std::vector<Association> associations_;    // scratch
-  std::vector<Eigen::Vector2d> moved_;       // scratch
+  std::vector<Eigen::Vector2d> ref_points_;   // in beam order
+  std::vector<std::int8_t> ref_has_next_;     // segment from point i to i+1
+  std::vector<Eigen::Vector2d> ref_normals_;  // unit surface normal at each point (zero if isolated)
+  std::vector<double> sorted_bearing_;        // bearings of reference points, ascending
+  std::vector<int> sorted_index_;             // their indices into ref_points_
+  std::vector<Association> associations_;     // scratch
+  std::vector<Eigen::Vector2d> moved_;        // scratch
 };
 
 }  // namespace hglasm

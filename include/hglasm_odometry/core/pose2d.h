@@ -43,6 +43,11 @@ Pose2D relativePose(const Pose2D& a, const Pose2D& b);
 /// extrapolates.
 Pose2D interpolate(const Pose2D& a, const Pose2D& b, double t);
 
+/// Covariance of the coordinates of a * b from those of a (in a's parent frame) and of b (in a's frame),
+/// to first order, a and b independent.
+Eigen::Matrix3d composeCovariance(const Pose2D& a, const Eigen::Matrix3d& cov_a, const Pose2D& b,
+                                  const Eigen::Matrix3d& cov_b);
+
 /// The adjoint of `pose`: maps a covariance of a small motion expressed in `pose`'s child frame into
 /// the parent frame (cov_parent = Ad * cov_child * Ad^T).
 Eigen::Matrix3d adjoint(const Pose2D& pose);

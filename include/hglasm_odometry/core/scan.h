@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
@@ -29,9 +30,9 @@ constexpr double kMaxSweepTime = 1.0;
 /// How a RangeScan becomes points. Ranges outside [max(range_min, min_range), min(range_max, max_range)],
 /// NaN, +-inf, zero and negative ranges are invalid and never used (REP-117).
 struct ScanConversionOptions {
-  double min_range = 0.0;                                        ///< extra lower limit, metres
-  double max_range = std::numeric_limits<double>::infinity();    ///< extra upper limit, metres
-  int beam_step = 1;                                             ///< keep every n-th beam (decimation)
+  double min_range = 0.0;                                      ///< extra lower limit, metres
+  double max_range = std::numeric_limits<double>::infinity();  ///< extra upper limit, metres
+  int beam_step = 1;                                           ///< keep every n-th beam (decimation)
   bool mirror = false;  ///< negate beam angles: an upside-down laser seen from above
   /// Seconds from the first beam to the last, assumed when the scan's own time_increment is 0 or not
   /// finite (converted logs, drivers that leave it out). 0: the beams' times stay unknown.
@@ -51,6 +52,26 @@ struct Scan {
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }
   bool hasBeamTimes() const { return std::isfinite(time_increment) && time_increment != 0.0; }
+};
+
+/// Reference points made of one or several scans in one frame, each scan's points in beam order.
+/// Consecutive points of the same scan may be joined into a surface (lookup-table gaps, MbICP segments);
+/// points of different scans never are.
+struct ReferencePoints {
+  std::vector<Eigen::Vector2d> points;
+  std::vector<std::size_t> scan_starts;  ///< index of each scan's first point, ascending
+
+  /// Appends a scan's points moved by `pose` (the scan's frame in this set's frame) as a new scan.
+  void append(const std::vector<Eigen::Vector2d>& scan_points, const Pose2D& pose = Pose2D());
+
+  /// For each point: 1 if the next point belongs to the same scan.
+  std::vector<std::uint8_t> sameScanAsNext() const;
+  std::size_t size() const { return points.size(); }
+  bool empty() const { return points.empty(); }
+  void clear() {
+    points.clear();
+    scan_starts.clear();
+  }
 };
 
 /// Why a RangeScan could not be converted at all (its points are then empty).

@@ -47,26 +47,30 @@ MatcherOptions presetOptions(Preset preset);
 
 enum class MatchStatus {
   kOk,
-  kNoReference,          ///< match() before setReference(), or an empty reference
-  kTooFewPoints,         ///< the new scan has too few valid points
-  kLowFitness,           ///< (pre-alignment alone) nothing in the box fits
-  kMbicpFailed,          ///< MbICP: too few associations or degenerate geometry
-  kMbicpNotConverged,    ///< MbICP hit its iteration limit (result usable, flagged)
+  kNoReference,        ///< match() before setReference(), or an empty reference
+  kTooFewPoints,       ///< the new scan has too few valid points
+  kLowFitness,         ///< (pre-alignment alone) nothing in the box fits
+  kMbicpFailed,        ///< MbICP: too few associations or degenerate geometry
+  kMbicpNotConverged,  ///< MbICP hit its iteration limit (result usable, flagged)
 };
 const char* toString(MatchStatus status);
 
 struct MatchResult {
-  Pose2D pose;                 ///< new scan in the reference frame (final)
-  Pose2D prealigned_pose;      ///< after the GA (the guess when there is no GA stage)
+  Pose2D pose;             ///< new scan in the reference frame (final)
+  Pose2D prealigned_pose;  ///< after the GA (the guess when there is no GA stage)
   MatchStatus status = MatchStatus::kNoReference;
   std::uint32_t fitness = 0;   ///< GA fitness of prealigned_pose
   double fitness_ratio = 0.0;  ///< fitness / (max cell * points), in [0, 1]
   int evaluations = 0;         ///< GA fitness evaluations
   int iterations = 0;          ///< MbICP iterations
   int associations = 0;
-  double rms_error = 0.0;      ///< MbICP residual, metres
+  double rms_error = 0.0;  ///< MbICP residual, metres
   MbicpStatus mbicp_status = MbicpStatus::kConverged;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  ///< of (x, y, theta); see Mbicp
+  /// Calibrated information of the scan alone at `pose` (zero without an MbICP stage); see Mbicp.
+  Eigen::Matrix3d scan_information = Eigen::Matrix3d::Zero();
+  bool degenerate = false;  ///< the scan alone leaves a direction unconstrained (see Mbicp)
+  Pose2D scan_only_pose;    ///< where the scan alone puts the pose (see Mbicp)
   double prealign_ms = 0.0;
   double refine_ms = 0.0;
 
@@ -80,18 +84,26 @@ class ScanMatcher {
 
   /// Builds the lookup table (if the algorithm has a GA stage) and the MbICP reference.
   void setReference(const Scan& reference);
+  /// The same from several scans in one frame (a local map).
+  void setReference(const ReferencePoints& reference);
   bool hasReference() const { return has_reference_; }
   double lastTableBuildMs() const { return table_build_ms_; }
 
-  /// Matches `scan` (points in its own frame) against the reference, starting from `guess`.
-  MatchResult match(const Scan& scan, const Pose2D& guess,
-                    std::vector<Pose2D>* population_out = nullptr);
+  /// Matches `scan` (points in its own frame) against the reference, starting from `guess`. `effort`
+  /// (optional) replaces the preset's box and GA size; `prior` (optional) makes MbICP's result the
+  /// maximum a posteriori pose of scan and prior.
+  MatchResult match(const Scan& scan, const Pose2D& guess, std::vector<Pose2D>* population_out = nullptr,
+                    const SearchEffort* effort = nullptr, const PosePrior* prior = nullptr);
 
   /// MbICP alone from `guess` (no pre-alignment), e.g. to check a match that strayed far from a prediction.
-  MatchResult refine(const Scan& scan, const Pose2D& guess);
+  MatchResult refine(const Scan& scan, const Pose2D& guess, const PosePrior* prior = nullptr);
 
   /// Fitness ratio of `scan` at `pose` on the fine lookup table (0 without a table).
   double fitnessRatioAt(const Scan& scan, const Pose2D& pose) const;
+
+  /// Log-likelihood of `scan` at `pose` on the fine lookup table read as a likelihood field (see
+  /// LookupTable::logLikelihood), summed over the scan's points; 0 without a table.
+  double logLikelihoodAt(const Scan& scan, const Pose2D& pose, double outlier) const;
 
   const MatcherOptions& options() const { return options_; }
   const LookupTable& table() const { return table_; }
@@ -105,10 +117,13 @@ class ScanMatcher {
   Mbicp mbicp_;
   /// Fills the defaults of a result (the guess, a large covariance); false if there is nothing to match.
   bool startResult(const Scan& scan, const Pose2D& guess, MatchResult* result) const;
-  void refineInto(const Scan& scan, MatchResult* result);
+  void refineInto(const Scan& scan, const PosePrior* prior, MatchResult* result);
 
   bool has_reference_ = false;
   double table_build_ms_ = 0.0;
+  // The coarse table is built on first use: searches sized by a tight prior never need it.
+  ReferencePoints reference_;
+  bool coarse_table_stale_ = false;
 };
 
 }  // namespace hglasm
