@@ -1,5 +1,7 @@
 #include "hglasm_odometry/core/odometry_tracker.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -13,39 +15,43 @@ constexpr double kMaxVariance = 1e4;
 // scans ~1 ms apart whose stamps do not match their motion, and a per-step velocity would explode.
 constexpr double kVelocityBaseline = 0.1;  // seconds
 constexpr double kMaxVelocityAge = 2.0;    // seconds: older motion says nothing about the current speed
+constexpr int kMinFitnessHistory = 20;     // matches before the usual fit is known
+constexpr double kFitnessHalfLife = 50.0;  // matches
 
-/// Covariance of a ⊕ b from the covariances of a (parent frame) and b (a's frame), first order.
-Eigen::Matrix3d composeCovariance(const Pose2D& a, const Eigen::Matrix3d& cov_a, const Pose2D& b,
-                                  const Eigen::Matrix3d& cov_b) {
-  const Pose2D ab = a * b;
-  Eigen::Matrix3d j_a = Eigen::Matrix3d::Identity();
-  j_a(0, 2) = -(ab.y - a.y);
-  j_a(1, 2) = ab.x - a.x;
-  Eigen::Matrix3d j_b = Eigen::Matrix3d::Identity();
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  j_b.topLeftCorner<2, 2>() << c, -s, s, c;
-  Eigen::Matrix3d cov = j_a * cov_a * j_a.transpose() + j_b * cov_b * j_b.transpose();
-  cov = 0.5 * (cov + cov.transpose());
-  return cov.cwiseMin(kMaxVariance).cwiseMax(-kMaxVariance);
+Eigen::Matrix3d symmetricClamped(const Eigen::Matrix3d& covariance) {
+  const Eigen::Matrix3d symmetric = 0.5 * (covariance + covariance.transpose());
+  return symmetric.cwiseMin(kMaxVariance).cwiseMax(-kMaxVariance);
 }
 
-/// Covariance of a laser motion L re-expressed for the base motion B = M ⊕ L ⊕ M^-1 (first order):
-/// dB_t/dL_t = R_M, dB_t/dL_theta = -S R_L t_M (S = 90-degree rotation), dB_theta/dL_theta = 1.
-Eigen::Matrix3d laserToBaseCovariance(const Pose2D& mount, const Pose2D& laser_motion, const Eigen::Matrix3d& cov) {
-  const double cm = std::cos(mount.theta), sm = std::sin(mount.theta);
-  const double cl = std::cos(laser_motion.theta), sl = std::sin(laser_motion.theta);
-  const Eigen::Vector2d rotated_lever(cl * mount.x - sl * mount.y, sl * mount.x + cl * mount.y);
-  Eigen::Matrix3d jacobian = Eigen::Matrix3d::Identity();
-  jacobian.topLeftCorner<2, 2>() << cm, -sm, sm, cm;
-  jacobian(0, 2) = rotated_lever.y();
-  jacobian(1, 2) = -rotated_lever.x();
-  return jacobian * cov * jacobian.transpose();
+/// composeCovariance, kept finite.
+Eigen::Matrix3d composeClamped(const Pose2D& a, const Eigen::Matrix3d& cov_a, const Pose2D& b,
+                               const Eigen::Matrix3d& cov_b) {
+  return symmetricClamped(composeCovariance(a, cov_a, b, cov_b));
 }
 
-Eigen::Matrix3d odometryNoise(const TrackerOptions& options, const Pose2D& motion) {
-  const double sigma_xy = options.odometry_noise_xy * motion.translationNorm() + 0.01;
-  const double sigma_theta = options.odometry_noise_theta * std::abs(motion.theta) + 0.005;
-  return Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_theta * sigma_theta).asDiagonal();
+/// d f / d x at x (x, y, theta coordinates, angles wrapped), by central differences: for the few
+/// rigid-frame changes per scan whose Jacobians are tedious to write out (a laser mount's lever arm).
+template <typename Function>
+Eigen::Matrix3d jacobianOf(const Function& f, const Pose2D& x) {
+  constexpr double kStep = 1e-6;
+  Eigen::Matrix3d jacobian;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3d delta = Eigen::Vector3d::Zero();
+    delta[k] = kStep;
+    const Pose2D plus = f(Pose2D(x.x + delta.x(), x.y + delta.y(), x.theta + delta.z()));
+    const Pose2D minus = f(Pose2D(x.x - delta.x(), x.y - delta.y(), x.theta - delta.z()));
+    jacobian.col(k) << (plus.x - minus.x) / (2 * kStep), (plus.y - minus.y) / (2 * kStep),
+        normalizeAngle(plus.theta - minus.theta) / (2 * kStep);
+  }
+  return jacobian;
+}
+
+/// Covariance of a pose's coordinates after its frame is changed by the rigid motion `frame_change`.
+Eigen::Matrix3d rotateCovariance(const Pose2D& frame_change, const Eigen::Matrix3d& covariance) {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  const double c = std::cos(frame_change.theta), s = std::sin(frame_change.theta);
+  rotation.topLeftCorner<2, 2>() << c, -s, s, c;
+  return symmetricClamped(rotation * covariance * rotation.transpose());
 }
 
 /// The laser's velocity (vx, vy, omega in the laser frame) from the base's (base frame): the lever arm
@@ -57,32 +63,46 @@ Eigen::Vector3d laserVelocity(const Pose2D& mount, const Eigen::Vector3d& base_v
   return Eigen::Vector3d(c * at_laser.x() + s * at_laser.y(), -s * at_laser.x() + c * at_laser.y(), omega);
 }
 
-/// Information-weighted mean of a degenerate match and the prediction (both base motions since the
-/// keyframe, first order in the keyframe frame): the match decides the directions it constrains, the
-/// prediction the one it does not (along a featureless corridor). Covariances must be positive definite.
-Pose2D fuseWithPrediction(const Pose2D& match, const Eigen::Matrix3d& match_cov, const Pose2D& prediction,
-                          const Eigen::Matrix3d& prediction_cov, Eigen::Matrix3d* fused_cov) {
-  const Eigen::Matrix3d match_info = match_cov.inverse();
-  const Eigen::Matrix3d fused = (match_info + prediction_cov.inverse()).inverse();
-  const Eigen::Vector3d innovation(match.x - prediction.x, match.y - prediction.y,
-                                   normalizeAngle(match.theta - prediction.theta));
-  const Eigen::Vector3d correction = fused * match_info * innovation;
-  *fused_cov = 0.5 * (fused + fused.transpose());
-  return Pose2D(prediction.x + correction.x(), prediction.y + correction.y(), prediction.theta + correction.z());
+Eigen::Vector3d poseDifference(const Pose2D& a, const Pose2D& b) {
+  return Eigen::Vector3d(a.x - b.x, a.y - b.y, normalizeAngle(a.theta - b.theta));
+}
+
+/// Inverse of a covariance that may be nearly singular in one direction (a prior's never is).
+Eigen::Matrix3d informationOf(const Eigen::Matrix3d& covariance) {
+  return (covariance + Eigen::Matrix3d::Identity() * 1e-12).inverse();
+}
+
+bool matchUsable(const MatchResult& match) {
+  return (match.status == MatchStatus::kOk || match.status == MatchStatus::kMbicpNotConverged) &&
+         match.pose.isFinite();
 }
 
 }  // namespace
 
+void OdometryTracker::RunningStats::add(double value) {
+  // Exponentially weighted mean and variance: the usual fit drifts with the scene.
+  const double alpha =
+      count == 0 ? 1.0 : std::max(1.0 / (count + 1), 1.0 - std::exp2(-1.0 / kFitnessHalfLife));
+  const double delta = value - mean;
+  mean += alpha * delta;
+  variance = (1.0 - alpha) * (variance + alpha * delta * delta);
+  ++count;
+}
+
 const char* toString(PredictionSource source) {
   switch (source) {
-    case PredictionSource::kOdometry: return "odometry";
-    case PredictionSource::kConstantVelocity: return "constant_velocity";
-    case PredictionSource::kNone: return "none";
+    case PredictionSource::kOdometry:
+      return "odometry";
+    case PredictionSource::kConstantVelocity:
+      return "constant_velocity";
+    case PredictionSource::kNone:
+      return "none";
   }
   return "unknown";
 }
 
-OdometryTracker::OdometryTracker(const TrackerOptions& options) : options_(options), matcher_(options.matcher) {}
+OdometryTracker::OdometryTracker(const TrackerOptions& options)
+    : options_(options), matcher_(options.matcher), noise_(options.motion), local_map_(options.local_map) {}
 
 void OdometryTracker::setLaserMount(const Pose2D& base_to_laser) {
   if (base_to_laser.isFinite()) laser_mount_ = base_to_laser;
@@ -92,48 +112,29 @@ void OdometryTracker::addOdometry(double stamp, const Pose2D& odom_pose) { odome
 
 void OdometryTracker::reset() {
   initialised_ = false;
-  has_keyframe_ = false;
+  local_map_.clear();
+  keyframe_requested_ = false;
   pose_ = Pose2D();
   pose_covariance_.setZero();
+  map_covariance_.setZero();
   velocity_.setZero();
   velocity_valid_ = false;
-  recent_fitness_ = 0.0;
+  prediction_wrong_ = 0.0;
+  fitness_ = RunningStats();
+  have_scan_only_pose_ = false;
   history_.clear();
 }
 
-void OdometryTracker::guardAgainstJump(const Scan& scan, const Pose2D& laser_guess, PredictionSource prediction,
-                                       TrackerUpdate* update) {
-  if (prediction == PredictionSource::kNone || !usesGeneticStage(options_.matcher.algorithm)) return;
-  // The guess relative to the keyframe is the predicted motion since the keyframe.
-  const auto far_from_guess = [&](const Pose2D& pose) {
-    const Pose2D deviation = relativePose(laser_guess, pose);
-    return deviation.translationNorm() > options_.jump_distance + options_.jump_fraction * laser_guess.translationNorm() ||
-           std::abs(deviation.theta) > options_.jump_angle + options_.jump_fraction * std::abs(laser_guess.theta);
-  };
-  if (!far_from_guess(update->match.pose)) return;
-  const double jump_fitness = matcher_.fitnessRatioAt(scan, update->match.pose);
-  const MatchResult from_guess = matcher_.refine(scan, laser_guess);
-  const bool guess_refined = (from_guess.status == MatchStatus::kOk ||
-                              from_guess.status == MatchStatus::kMbicpNotConverged) &&
-                             !far_from_guess(from_guess.pose);
-  if (jump_fitness >= options_.jump_min_relative_fitness * recent_fitness_ &&
-      (!guess_refined || jump_fitness > from_guess.fitness_ratio + options_.jump_margin)) {
-    return;  // a convincing leap: the prediction was wrong (wheel slip, a kidnapped robot)
-  }
-  update->jump_rejected = true;
-  if (!guess_refined) {
-    update->match.status = MatchStatus::kLowFitness;  // neither is convincing: fall back to the prediction
-    return;
-  }
-  MatchResult kept = from_guess;
-  kept.prealign_ms = update->match.prealign_ms;
-  kept.refine_ms += update->match.refine_ms;
-  kept.evaluations = update->match.evaluations;
-  kept.prealigned_pose = update->match.prealigned_pose;
-  update->match = kept;
+Pose2D OdometryTracker::toMap(const Pose2D& base_pose) const {
+  return local_map_.frame().inverse() * base_pose * laser_mount_;
 }
 
-PredictionSource OdometryTracker::predict(double stamp, Pose2D* predicted, std::string* warning) const {
+Pose2D OdometryTracker::fromMap(const Pose2D& laser_in_map) const {
+  return local_map_.frame() * laser_in_map * laser_mount_.inverse();
+}
+
+OdometryTracker::Prediction OdometryTracker::predict(double stamp, std::string* warning) const {
+  Prediction prediction;
   const double dt = stamp - last_stamp_;
   if (options_.use_odometry) {
     Pose2D odom_last, odom_now;
@@ -143,32 +144,348 @@ PredictionSource OdometryTracker::predict(double stamp, Pose2D* predicted, std::
       const bool plausible = motion.translationNorm() <= options_.max_odometry_speed * dt + 0.2 &&
                              std::abs(motion.theta) <= options_.max_odometry_turn_rate * dt + 0.2;
       if (plausible) {
-        *predicted = pose_ * motion;
-        return PredictionSource::kOdometry;
+        prediction.source = PredictionSource::kOdometry;
+        prediction.motion = motion;
+        prediction.covariance = noise_.odometryCovariance(motion, dt);
+        prediction.nominal_covariance = noise_.nominalOdometryCovariance(motion, dt);
+        return prediction;
       }
       std::ostringstream text;
-      text << "wheel odometry jumped " << motion.translationNorm() << " m / " << motion.theta << " rad in " << dt
-           << " s; using the constant-velocity prediction";
+      text << "wheel odometry jumped " << motion.translationNorm() << " m / " << motion.theta << " rad in "
+           << dt << " s; using the constant-velocity prediction";
       *warning = text.str();
     }
   }
+  prediction.covariance = noise_.constantVelocityCovariance(dt);
   if (velocity_valid_) {
-    *predicted = pose_ * Pose2D(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
-    return PredictionSource::kConstantVelocity;
+    prediction.source = PredictionSource::kConstantVelocity;
+    prediction.motion = Pose2D(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
   }
-  *predicted = pose_;
-  return PredictionSource::kNone;
+  return prediction;
 }
 
-void OdometryTracker::setKeyframe(const Scan& scan, const Pose2D& pose,
-                                  const Eigen::Matrix3d& covariance) {
-  matcher_.setReference(scan);
-  has_keyframe_ = matcher_.hasReference();
+SearchEffort OdometryTracker::searchEffort(const Eigen::Matrix3d& prior_covariance, bool have_prior) const {
+  const GeneticOptions& configured = options_.matcher.genetic;
+  SearchEffort effort = effortOf(configured);
+  if (!have_prior) return effort;
+  const auto half_width = [&](int axis, double minimum, double maximum) {
+    const double sigma = std::sqrt(std::max(0.0, prior_covariance(axis, axis)));
+    return std::clamp(options_.search_sigmas * sigma, std::min(minimum, maximum), maximum);
+  };
+  effort.box.half_x = half_width(0, options_.min_search_xy, configured.box.half_x);
+  effort.box.half_y = half_width(1, options_.min_search_xy, configured.box.half_y);
+  effort.box.half_theta = half_width(2, options_.min_search_theta, configured.box.half_theta);
+  // The GA size of the smallest of the papers' presets whose box holds this one, capped by the configured
+  // preset's (Table 1 grows box and GA together).
+  for (Preset preset : {Preset::kSmall, Preset::kMedium}) {
+    const GeneticOptions tier = presetOptions(preset).genetic;
+    if (effort.box.half_x <= tier.box.half_x && effort.box.half_y <= tier.box.half_y &&
+        effort.box.half_theta <= tier.box.half_theta) {
+      effort.population = std::min(tier.population, configured.population);
+      effort.generations = std::min(tier.generations, configured.generations);
+      effort.runs = std::min(tier.runs, configured.runs);
+      effort.coarse_generations = std::min(tier.coarse_generations, effort.generations);
+      break;
+    }
+  }
+  return effort;
+}
+
+OdometryTracker::Candidate OdometryTracker::evaluate(const Scan& scan, const MatchResult& match,
+                                                     const PosePrior& prior) const {
+  Candidate candidate;
+  candidate.match = match;
+  const Eigen::Vector3d offset = poseDifference(match.pose, prior.mean);
+  candidate.mahalanobis_sq = match.pose.isFinite() ? offset.dot(prior.information * offset) : 0.0;
+  candidate.fitness_ratio = match.pose.isFinite() ? matcher_.fitnessRatioAt(scan, match.pose) : 0.0;
+  candidate.acceptable = matchUsable(match) && candidate.fitness_ratio >= options_.min_fitness;
+  return candidate;
+}
+
+bool OdometryTracker::predictionInDoubt(const Candidate& tight, const PosePrior& prior,
+                                        const Eigen::Matrix3d& prior_covariance) const {
+  const double gate_sq = options_.max_mahalanobis * options_.max_mahalanobis;
+  if (!tight.acceptable || tight.mahalanobis_sq > gate_sq) return true;
+  // The scan fits the map far worse than scans usually do: the pose near the prediction is not its place.
+  if (fitness_.count >= kMinFitnessHistory &&
+      tight.fitness_ratio < fitness_.mean - options_.max_mahalanobis * std::sqrt(fitness_.variance)) {
+    return true;
+  }
+  // The innovation test: where the scan alone would put the pose, against the prediction, with both
+  // uncertainties (directions the scan does not constrain carry no innovation).
+  const Eigen::Vector3d innovation = poseDifference(tight.match.scan_only_pose, prior.mean);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(tight.match.scan_information);
+  const Eigen::Vector3d eigenvalues = solver.eigenvalues();
+  Eigen::Vector3d scan_variances;
+  for (int i = 0; i < 3; ++i) {
+    scan_variances[i] =
+        eigenvalues[i] > 1e-6 * std::max(eigenvalues.maxCoeff(), 1e-12) ? 1.0 / eigenvalues[i] : kMaxVariance;
+  }
+  const Eigen::Matrix3d scan_covariance =
+      solver.eigenvectors() * scan_variances.asDiagonal() * solver.eigenvectors().transpose();
+  const Eigen::Matrix3d total = prior_covariance + scan_covariance;
+  const double innovation_sq = innovation.dot(total.ldlt().solve(innovation));
+  return !(innovation_sq <= gate_sq);
+}
+
+double OdometryTracker::scanLogLikelihood(const Scan& scan, const Pose2D& pose) const {
+  // The scan's likelihood counts its independent points only, as its information does.
+  const double independent = options_.matcher.mbicp.independent_points;
+  const double weight =
+      independent > 0.0 ? std::min(1.0, independent / std::max<double>(1.0, scan.size())) : 1.0;
+  return weight * matcher_.logLikelihoodAt(scan, pose, options_.likelihood_outlier);
+}
+
+double OdometryTracker::logPrior(const Pose2D& pose, const PosePrior& prior,
+                                 const Eigen::Matrix3d& covariance) {
+  const Eigen::Vector3d offset = poseDifference(pose, prior.mean);
+  const double log_det = std::log(std::max((2.0 * M_PI * covariance).determinant(), 1e-300));
+  return -0.5 * offset.dot(prior.information * offset) - 0.5 * log_det;
+}
+
+bool OdometryTracker::matchScan(const Scan& scan, const Prediction& prediction,
+                                std::vector<Pose2D>* population_out, TrackerUpdate* update,
+                                Estimate* estimate) {
+  // The prior: the laser's predicted pose in the local map's frame, uncertain by the previous estimate's
+  // uncertainty there plus the motion's noise.
+  const Pose2D laser_previous = toMap(pose_);
+  const auto to_laser_motion = [this](const Pose2D& base_motion) {
+    return laser_mount_.inverse() * base_motion * laser_mount_;
+  };
+  const Pose2D laser_motion = to_laser_motion(prediction.motion);
+  const Eigen::Matrix3d to_laser = jacobianOf(to_laser_motion, prediction.motion);
+  const Eigen::Matrix3d zero = Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d previous_part = composeClamped(laser_previous, map_covariance_, laser_motion, zero);
+  const Eigen::Matrix3d motion_part = composeClamped(laser_previous, zero, laser_motion,
+                                                     to_laser * prediction.covariance * to_laser.transpose());
+  // Without fusion (an ablation: the match replaces the prediction) the prediction only centres the search.
+  const bool have_prior = options_.fusion && prediction.source != PredictionSource::kNone;
+  Eigen::Matrix3d prior_covariance = previous_part + motion_part;
+  if (!have_prior) {
+    // No motion known yet: flat over the preset's box (its half-widths as search_sigmas sigma).
+    const SearchBox& box = options_.matcher.genetic.box;
+    prior_covariance = Eigen::Vector3d(box.half_x, box.half_y, box.half_theta).cwiseAbs2().asDiagonal();
+    prior_covariance /= options_.search_sigmas * options_.search_sigmas;
+  }
+  PosePrior prior;
+  prior.mean = laser_previous * laser_motion;
+  prior.information = informationOf(prior_covariance);
+
+  update->search = searchEffort(prior_covariance, have_prior);
+  Candidate chosen = evaluate(
+      scan,
+      matcher_.match(scan, prior.mean, population_out, &update->search, options_.fusion ? &prior : nullptr),
+      prior);
+  // Two hypotheses: the prediction holds (its noise model), or it is wrong (wheel slip, a glitch, a
+  // kidnap) and the pose can be anywhere in the preset's box. Their prior odds follow the last scan's: a
+  // prediction that was wrong tends to stay wrong for a while.
+  const double wrong_prior = std::clamp(
+      (1.0 - prediction_wrong_) * options_.leap_probability + prediction_wrong_ * options_.leap_persistence,
+      1e-12, 1.0 - 1e-12);
+  const SearchEffort wide = searchEffort(prior_covariance, false);
+  Eigen::Matrix3d wide_covariance = prior_covariance;
+  wide_covariance.diagonal() +=
+      Eigen::Vector3d(wide.box.half_x, wide.box.half_y, wide.box.half_theta).cwiseAbs2() /
+      (options_.search_sigmas * options_.search_sigmas);
+  const PosePrior wide_prior{prior.mean, informationOf(wide_covariance)};
+  // Each hypothesis' evidence for a match, in the Laplace approximation: the scan's likelihood at the pose,
+  // the hypothesis' prior density there, and the volume of the posterior around it (a hypothesis that
+  // leaves a direction to the scan, and the scan leaves it open too, loses no probability for it).
+  const auto hypothesis_scores = [&](const MatchResult& match, double* holds, double* wrong) {
+    const double likelihood = scanLogLikelihood(scan, match.pose);
+    const auto log_volume = [&](const PosePrior& hypothesis) {
+      const Eigen::Matrix3d posterior = informationOf(match.scan_information + hypothesis.information);
+      return 0.5 * std::log(std::max((2.0 * M_PI * posterior).determinant(), 1e-300));
+    };
+    *holds = likelihood + logPrior(match.pose, prior, prior_covariance) + log_volume(prior) +
+             std::log1p(-wrong_prior);
+    *wrong = likelihood + logPrior(match.pose, wide_prior, wide_covariance) + log_volume(wide_prior) +
+             std::log(wrong_prior);
+  };
+  double holds = 0.0, wrong = 0.0;
+  prediction_wrong_ = wrong_prior;
+  if (have_prior && chosen.acceptable) {
+    hypothesis_scores(chosen.match, &holds, &wrong);
+    prediction_wrong_ = 1.0 / (1.0 + std::exp(holds - wrong));
+  }
+  if (have_prior && usesGeneticStage(options_.matcher.algorithm) &&
+      predictionInDoubt(chosen, prior, prior_covariance)) {
+    // Search the preset's whole box under the second hypothesis; the matches compete by posterior.
+    update->prediction_doubted = true;
+    std::vector<Pose2D> wide_population;
+    Candidate leap = evaluate(
+        scan,
+        matcher_.match(scan, prior.mean, population_out ? &wide_population : nullptr, &wide, &wide_prior),
+        prior);
+    const double stay_score = chosen.acceptable ? std::max(holds, wrong) : -HUGE_VAL;
+    double leap_holds = -HUGE_VAL, leap_wrong = -HUGE_VAL;
+    if (leap.acceptable) hypothesis_scores(leap.match, &leap_holds, &leap_wrong);
+    const bool leap_is_far = leap.mahalanobis_sq > options_.max_mahalanobis * options_.max_mahalanobis;
+    if (std::max(leap_holds, leap_wrong) > stay_score) {
+      leap.match.prealign_ms += chosen.match.prealign_ms;
+      leap.match.refine_ms += chosen.match.refine_ms;
+      leap.match.evaluations += chosen.match.evaluations;
+      update->leap = leap_is_far;
+      update->search = wide;
+      chosen = leap;
+      prediction_wrong_ = 1.0 / (1.0 + std::exp(leap_holds - leap_wrong));
+      if (population_out) *population_out = wide_population;
+    } else {
+      update->jump_rejected = leap.acceptable && leap_is_far;
+      chosen.match.prealign_ms += leap.match.prealign_ms;
+      chosen.match.refine_ms += leap.match.refine_ms;
+      chosen.match.evaluations += leap.match.evaluations;
+    }
+  }
+  if (!chosen.acceptable) prediction_wrong_ = wrong_prior;
+  update->leap_probability = prediction_wrong_;
+  update->match = chosen.match;
+  update->prior_mahalanobis = std::sqrt(chosen.mahalanobis_sq);
+  if (population_out) {
+    for (auto& pose : *population_out) pose = fromMap(pose);
+  }
+  if (!chosen.acceptable) return false;
+  update->fitness_ratio = chosen.fitness_ratio;
+  fitness_.add(chosen.fitness_ratio);
+
+  estimate->laser_in_map = chosen.match.pose;
+  estimate->map_covariance = symmetricClamped(chosen.match.covariance);
+  // The increment's uncertainty: the scan's information fused with the motion's noise alone (the previous
+  // pose's uncertainty is the trajectory's, already counted): the scan decides where it constrains the
+  // pose, the wheels where it does not (along a corridor).
+  const Eigen::Matrix3d increment_in_map =
+      have_prior ? informationOf(chosen.match.scan_information + informationOf(motion_part))
+                 : estimate->map_covariance;
+  const Pose2D previous = pose_;
+  const Eigen::Matrix3d to_increment = jacobianOf(
+      [&](const Pose2D& laser) { return relativePose(previous, fromMap(laser)); }, chosen.match.pose);
+  estimate->increment_covariance =
+      symmetricClamped(to_increment * increment_in_map * to_increment.transpose());
+  if (!update->leap) {
+    learnNoise(prediction, chosen.match);
+  } else {
+    have_scan_only_pose_ = false;  // the wheels were wrong beyond their noise: an outlier, not their noise
+  }
+  return true;
+}
+
+void OdometryTracker::learnNoise(const Prediction& prediction, const MatchResult& match) {
+  // Two consecutive scans matched against the same map share most of their error, so the motion between
+  // where the scans alone put them is a far better measurement of the increment than any wheels': what
+  // the wheels' increment differs from it by is (almost all) their noise.
+  const Pose2D scan_only = fromMap(match.scan_only_pose);
+  const bool usable =
+      prediction.source == PredictionSource::kOdometry && !match.degenerate && scan_only.isFinite();
+  if (usable && have_scan_only_pose_) {
+    const Pose2D wheel_error = relativePose(prediction.motion, relativePose(scan_only_pose_, scan_only));
+    noise_.learn(Eigen::Vector3d(wheel_error.x, wheel_error.y, wheel_error.theta), Eigen::Vector3d::Zero(),
+                 prediction.nominal_covariance.diagonal());
+  }
+  have_scan_only_pose_ = usable;
+  scan_only_pose_ = scan_only;
+}
+
+OdometryTracker::Estimate OdometryTracker::integratePrediction(const Prediction& prediction) const {
+  Estimate estimate;
+  const Pose2D laser_previous = toMap(pose_);
+  const Pose2D laser_motion = laser_mount_.inverse() * prediction.motion * laser_mount_;
+  estimate.laser_in_map = laser_previous * laser_motion;
+  const Eigen::Matrix3d to_laser =
+      jacobianOf([this](const Pose2D& motion) { return laser_mount_.inverse() * motion * laser_mount_; },
+                 prediction.motion);
+  estimate.map_covariance = composeClamped(laser_previous, map_covariance_, laser_motion,
+                                           to_laser * prediction.covariance * to_laser.transpose());
+  estimate.increment_covariance =
+      symmetricClamped(prediction.covariance * options_.fallback_covariance_scale);
+  return estimate;
+}
+
+bool OdometryTracker::handleTime(double stamp, TrackerUpdate* update) {
+  if (!initialised_) return true;
+  const double dt = stamp - last_stamp_;
+  if (dt >= 0.0 && dt <= options_.max_time_jump) return true;
+  std::ostringstream text;
+  text << "scan time " << (dt < 0.0 ? "went back" : "jumped forward") << " by " << std::abs(dt)
+       << " s; odometry reset to the origin";
+  update->warning = text.str();
+  reset();
+  // Back in time, the odometry history is of another timeline (a looped bag, a clock reset): mixed with
+  // the new samples at the same stamps it would turn every prediction into a jump.
+  if (dt < 0.0) odometry_.clear();
+  return false;
+}
+
+void OdometryTracker::initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update) {
+  initialised_ = true;
+  last_stamp_ = stamp;
+  history_.push_back(StampedPose{stamp, pose_});
+  update->reset = true;
+  update->published = true;
+  update->pose = pose_;
+  update->pose_covariance = pose_covariance_;
+  if (usable) {
+    addKeyframe(scan);
+    update->new_keyframe = true;
+    update->table_build_ms = matcher_.lastTableBuildMs();
+  }
+  update->keyframe_id = keyframe_id_;
+}
+
+void OdometryTracker::updateVelocity(double stamp, const Pose2D& new_pose, TrackerUpdate* update) {
+  // Velocity over a baseline of at least kVelocityBaseline seconds, capped at the plausible speeds.
+  history_.push_back(StampedPose{stamp, new_pose});
+  while (history_.size() > 2 && stamp - history_[1].stamp >= kVelocityBaseline) history_.pop_front();
+  const double baseline = stamp - history_.front().stamp;
+  if (baseline >= kVelocityBaseline && baseline <= kMaxVelocityAge) {
+    const Pose2D motion = relativePose(history_.front().pose, new_pose);
+    Eigen::Vector3d velocity(motion.x / baseline, motion.y / baseline, motion.theta / baseline);
+    const double speed = velocity.head<2>().norm();
+    if (speed > options_.max_odometry_speed) velocity.head<2>() *= options_.max_odometry_speed / speed;
+    velocity.z() =
+        std::clamp(velocity.z(), -options_.max_odometry_turn_rate, options_.max_odometry_turn_rate);
+    velocity_ = velocity;
+    velocity_valid_ = true;
+    update->velocity_covariance = symmetricClamped(update->increment_covariance / (baseline * baseline));
+  } else {
+    if (baseline > kMaxVelocityAge) velocity_valid_ = false;
+    update->velocity_covariance = Eigen::Matrix3d::Identity() * kMaxVariance;
+  }
+}
+
+void OdometryTracker::addKeyframe(const Scan& scan) {
+  const bool had_map = !local_map_.empty();
+  const Pose2D old_frame = local_map_.frame();
+  local_map_.add(pose_ * laser_mount_, scan.points);
+  matcher_.setReference(local_map_.reference());
+  // The pose's uncertainty relative to the map stays; only the frame it is expressed in turns.
+  map_covariance_ = had_map ? rotateCovariance(relativePose(local_map_.frame(), old_frame), map_covariance_)
+                            : Eigen::Matrix3d::Zero();
   keyframe_requested_ = false;
-  keyframe_pose_ = pose;
-  keyframe_covariance_ = covariance;
+  keyframe_pose_ = pose_;
   keyframe_beam_count_ = scan.beam_count;
   ++keyframe_id_;
+}
+
+void OdometryTracker::updateKeyframe(const Scan& scan, bool usable, TrackerUpdate* update) {
+  // A new keyframe when the robot has moved away from the last one, when the match was poor or failed (the
+  // map no longer explains the scene), or when the scanner changed.
+  const Pose2D since_keyframe = relativePose(keyframe_pose_, pose_);
+  // Only a usable scan can become a keyframe (an empty scan has no geometry): warn when it does.
+  const bool geometry_changed = !local_map_.empty() && usable && scan.beam_count != keyframe_beam_count_;
+  if (geometry_changed && update->warning.empty()) {
+    update->warning = "scan beam count changed from " + std::to_string(keyframe_beam_count_) + " to " +
+                      std::to_string(scan.beam_count) + "; new keyframe";
+  }
+  const bool wants_keyframe = local_map_.empty() || keyframe_requested_ || geometry_changed ||
+                              update->fallback ||
+                              since_keyframe.translationNorm() > options_.keyframe_distance ||
+                              std::abs(since_keyframe.theta) > options_.keyframe_angle ||
+                              (update->matched && update->fitness_ratio < options_.keyframe_min_fitness);
+  if (wants_keyframe && usable) {
+    addKeyframe(scan);
+    update->new_keyframe = true;
+    update->table_build_ms = matcher_.lastTableBuildMs();
+  }
 }
 
 TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan,
@@ -182,20 +499,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
     update.pose_covariance = pose_covariance_;
     return update;
   }
-
-  if (initialised_) {
-    const double dt = stamp - last_stamp_;
-    if (dt < 0.0 || dt > options_.max_time_jump) {
-      std::ostringstream text;
-      text << "scan time " << (dt < 0.0 ? "went back" : "jumped forward") << " by " << std::abs(dt)
-           << " s; odometry reset to the origin";
-      update.warning = text.str();
-      reset();
-      // Back in time, the odometry history is of another timeline (a looped bag, a clock reset): mixed with
-      // the new samples at the same stamps it would turn every prediction into a jump.
-      if (dt < 0.0) odometry_.clear();
-    }
-  }
+  handleTime(stamp, &update);
 
   // A sweep taken while moving is sheared (the last beam is milliseconds younger than the first), and a
   // match reads the shear as a small turn of one sign per metre: on fr079 it added up to ~25 degrees.
@@ -204,133 +508,49 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   if (deskew) compensated = deskewScan(sensor_scan, laserVelocity(laser_mount_, velocity_));
   const Scan& scan = deskew ? compensated : sensor_scan;
   update.deskewed = deskew;
-
   const bool usable = static_cast<int>(scan.size()) >= options_.min_points;
   if (!initialised_) {
-    initialised_ = true;
-    last_stamp_ = stamp;
-    history_.push_back(StampedPose{stamp, pose_});
-    update.reset = true;
-    update.published = true;
-    update.pose = pose_;
-    update.pose_covariance = pose_covariance_;
-    if (usable) {
-      setKeyframe(scan, pose_, pose_covariance_);
-      update.new_keyframe = true;
-      update.table_build_ms = matcher_.lastTableBuildMs();
-    }
-    update.keyframe_id = keyframe_id_;
+    initialise(stamp, scan, usable, &update);
+    update.noise_scale = noise_.scale();
     return update;
   }
 
-  Pose2D predicted;
   std::string prediction_warning;
-  update.prediction = predict(stamp, &predicted, &prediction_warning);
+  const Prediction prediction = predict(stamp, &prediction_warning);
   if (update.warning.empty()) update.warning = prediction_warning;
-  update.guess = predicted;
-  const Pose2D predicted_step = relativePose(pose_, predicted);
+  update.prediction = prediction.source;
+  update.guess = pose_ * prediction.motion;
 
-  Pose2D new_pose = predicted;
-  Eigen::Matrix3d new_covariance =
-      composeCovariance(pose_, pose_covariance_, predicted_step, odometryNoise(options_, predicted_step));
-  Eigen::Matrix3d step_covariance = odometryNoise(options_, predicted_step) * options_.fallback_covariance_scale;
-
-  if (has_keyframe_ && usable) {
-    // Guess of the new laser pose in the keyframe's laser frame: conjugate the base motion by the mount.
-    const Pose2D base_motion = relativePose(keyframe_pose_, predicted);
-    const Pose2D laser_guess = laser_mount_.inverse() * base_motion * laser_mount_;
-    std::vector<Pose2D>* population = population_out;
-    update.match = matcher_.match(scan, laser_guess, population);
+  Estimate estimate;
+  bool matched = false;
+  if (!local_map_.empty() && usable) {
     update.matched = true;
-    guardAgainstJump(scan, laser_guess, update.prediction, &update);
-    const bool fits = update.match.fitness_ratio >= options_.min_fitness && update.match.pose.isFinite();
-    const bool match_ok = (update.match.status == MatchStatus::kOk ||
-                           update.match.status == MatchStatus::kMbicpNotConverged) && fits;
-    // Degenerate geometry (a featureless corridor): the scan still fixes some directions; its covariance
-    // carries the maximum variance along the others, where the prediction decides.
-    const bool degenerate = update.match.status == MatchStatus::kMbicpFailed &&
-                            update.match.mbicp_status == MbicpStatus::kDegenerate && fits &&
-                            update.match.covariance.allFinite();
-    if (match_ok) {
-      recent_fitness_ = recent_fitness_ > 0.0 ? 0.8 * recent_fitness_ + 0.2 * update.match.fitness_ratio
-                                              : update.match.fitness_ratio;
-      const Pose2D base_estimate = laser_mount_ * update.match.pose * laser_mount_.inverse();
-      const Eigen::Matrix3d base_cov = laserToBaseCovariance(laser_mount_, update.match.pose, update.match.covariance);
-      new_pose = keyframe_pose_ * base_estimate;
-      new_covariance = composeCovariance(keyframe_pose_, keyframe_covariance_, base_estimate, base_cov);
-      step_covariance = base_cov;
-    } else if (degenerate) {
-      const Pose2D base_estimate = laser_mount_ * update.match.pose * laser_mount_.inverse();
-      const Eigen::Matrix3d base_cov = laserToBaseCovariance(laser_mount_, update.match.pose, update.match.covariance);
-      Eigen::Matrix3d fused_cov;
-      const Pose2D fused =
-          fuseWithPrediction(base_estimate, base_cov, base_motion, odometryNoise(options_, base_motion), &fused_cov);
-      if (fused.isFinite() && fused_cov.allFinite()) {
-        new_pose = keyframe_pose_ * fused;
-        new_covariance = composeCovariance(keyframe_pose_, keyframe_covariance_, fused, fused_cov);
-        step_covariance = fused_cov;
-      } else {
-        update.fallback = true;
-      }
-    } else {
-      update.fallback = true;
-    }
-    if (population_out) {
-      for (auto& pose : *population_out) pose = keyframe_pose_ * (laser_mount_ * pose * laser_mount_.inverse());
-    }
+    update.map_keyframes = static_cast<int>(local_map_.keyframeCount());
+    matched = matchScan(scan, prediction, population_out, &update, &estimate);
   } else {
-    update.fallback = true;  // nothing to match against (or nothing to match): keep the motion predicted
-    update.match.status = has_keyframe_ ? MatchStatus::kTooFewPoints : MatchStatus::kNoReference;
+    update.match.status = local_map_.empty() ? MatchStatus::kNoReference : MatchStatus::kTooFewPoints;
   }
-  if (update.fallback) new_covariance += step_covariance;
-
-  // Velocity over a baseline of at least kVelocityBaseline seconds, capped at the plausible speeds.
-  history_.push_back(StampedPose{stamp, new_pose});
-  while (history_.size() > 2 && stamp - history_[1].stamp >= kVelocityBaseline) history_.pop_front();
-  const double baseline = stamp - history_.front().stamp;
-  if (baseline >= kVelocityBaseline && baseline <= kMaxVelocityAge) {
-    const Pose2D motion = relativePose(history_.front().pose, new_pose);
-    Eigen::Vector3d velocity(motion.x / baseline, motion.y / baseline, motion.theta / baseline);
-    const double speed = velocity.head<2>().norm();
-    if (speed > options_.max_odometry_speed) velocity.head<2>() *= options_.max_odometry_speed / speed;
-    velocity.z() = std::clamp(velocity.z(), -options_.max_odometry_turn_rate, options_.max_odometry_turn_rate);
-    velocity_ = velocity;
-    velocity_valid_ = true;
-    update.velocity_covariance =
-        (step_covariance / (baseline * baseline)).cwiseMin(kMaxVariance).cwiseMax(-kMaxVariance);
-  } else {
-    if (baseline > kMaxVelocityAge) velocity_valid_ = false;
-    update.velocity_covariance = Eigen::Matrix3d::Identity() * kMaxVariance;
+  if (!matched) {
+    have_scan_only_pose_ = false;
+    update.fallback = true;  // nothing (convincing) to match: keep the motion predicted
+    estimate = integratePrediction(prediction);
   }
-
+  const Pose2D new_pose = fromMap(estimate.laser_in_map);
+  pose_covariance_ =
+      composeClamped(pose_, pose_covariance_, relativePose(pose_, new_pose), estimate.increment_covariance);
+  map_covariance_ = estimate.map_covariance;
+  update.increment_covariance = estimate.increment_covariance;
+  updateVelocity(stamp, new_pose, &update);
   pose_ = new_pose;
-  pose_covariance_ = new_covariance;
   last_stamp_ = stamp;
-
-  // A new reference when the robot has moved away from the keyframe, when the match was poor or failed
-  // (the old reference no longer explains the scene), or when the scanner changed.
-  const Pose2D since_keyframe = relativePose(keyframe_pose_, pose_);
-  // Only a usable scan can become the new keyframe (an empty scan has no geometry): warn when it does.
-  const bool geometry_changed = has_keyframe_ && usable && scan.beam_count != keyframe_beam_count_;
-  if (geometry_changed && update.warning.empty()) {
-    update.warning = "scan beam count changed from " + std::to_string(keyframe_beam_count_) + " to " +
-                     std::to_string(scan.beam_count) + "; new keyframe";
-  }
-  const bool wants_keyframe = !has_keyframe_ || keyframe_requested_ || geometry_changed || update.fallback ||
-                              since_keyframe.translationNorm() > options_.keyframe_distance ||
-                              std::abs(since_keyframe.theta) > options_.keyframe_angle ||
-                              (update.matched && update.match.fitness_ratio < options_.keyframe_min_fitness);
-  if (wants_keyframe && usable) {
-    setKeyframe(scan, pose_, pose_covariance_);
-    update.new_keyframe = true;
-    update.table_build_ms = matcher_.lastTableBuildMs();
-  }
+  updateKeyframe(scan, usable, &update);
 
   update.published = true;
   update.pose = pose_;
   update.pose_covariance = pose_covariance_;
   update.velocity = velocity_;
   update.keyframe_id = keyframe_id_;
+  update.noise_scale = noise_.scale();
   return update;
 }
 

@@ -235,17 +235,36 @@ void readOptions(ParamTree& tree, LaserOdometryOptions* options) {
   tree.number("fallback_covariance_scale", &tracker.fallback_covariance_scale, 1.0, 1e12);
   tree.positiveNumber("max_time_jump", &tracker.max_time_jump);
 
-  // Matches far from the prediction (a GA leap to a look-alike place) must prove themselves.
-  tree.nonNegativeNumber("jump/distance", &tracker.jump_distance);
-  tree.number("jump/angle", &tracker.jump_angle, 0.0, M_PI);
-  tree.nonNegativeNumber("jump/fraction", &tracker.jump_fraction);
-  tree.fraction("jump/margin", &tracker.jump_margin);
-  tree.nonNegativeNumber("jump/min_relative_fitness", &tracker.jump_min_relative_fitness);
+  // The search around the prediction, and leaps away from it.
+  tree.boolean("fusion", &tracker.fusion);
+  tree.positiveNumber("search/sigmas", &tracker.search_sigmas);
+  tree.nonNegativeNumber("search/min_xy", &tracker.min_search_xy);
+  tree.number("search/min_theta", &tracker.min_search_theta, 0.0, M_PI);
+  tree.positiveNumber("leap/max_mahalanobis", &tracker.max_mahalanobis);
+  tree.number("leap/probability", &tracker.leap_probability, 0.0, 0.5, true);
+  tree.number("leap/persistence", &tracker.leap_persistence, 0.0, 1.0, true);
+  tree.number("leap/likelihood_outlier", &tracker.likelihood_outlier, 0.0, 1.0, true);
 
-  // Wheel odometry as the prediction.
+  // The local map the scans are matched against.
+  tree.positiveInteger("local_map/keyframes", &tracker.local_map.keyframes);
+  tree.positiveNumber("local_map/max_distance", &tracker.local_map.max_distance);
+  tree.nonNegativeNumber("local_map/resolution", &tracker.local_map.resolution);
+
+  // Wheel odometry as the prediction, and its noise.
   tree.nonNegativeNumber("odometry/max_extrapolation", &tracker.odometry_max_extrapolation);
-  tree.nonNegativeNumber("odometry/noise_xy", &tracker.odometry_noise_xy);
-  tree.nonNegativeNumber("odometry/noise_theta", &tracker.odometry_noise_theta);
+  hglasm::MotionNoiseOptions& motion = tracker.motion;
+  tree.nonNegativeNumber("odometry/noise/xy_per_metre", &motion.xy_per_metre);
+  tree.nonNegativeNumber("odometry/noise/xy_per_radian", &motion.xy_per_radian);
+  tree.nonNegativeNumber("odometry/noise/xy_per_second", &motion.xy_per_second);
+  tree.nonNegativeNumber("odometry/noise/theta_per_metre", &motion.theta_per_metre);
+  tree.nonNegativeNumber("odometry/noise/theta_per_radian", &motion.theta_per_radian);
+  tree.nonNegativeNumber("odometry/noise/theta_per_second", &motion.theta_per_second);
+  tree.boolean("odometry/noise/learn", &motion.learn);
+  tree.positiveNumber("odometry/noise/learn_half_life", &motion.learn_half_life);
+  tree.positiveNumber("odometry/noise/min_scale", &motion.min_scale);
+  tree.positiveNumber("odometry/noise/max_scale", &motion.max_scale);
+  tree.positiveNumber("constant_velocity/xy", &motion.constant_velocity_xy);
+  tree.positiveNumber("constant_velocity/theta", &motion.constant_velocity_theta);
   tree.positiveNumber("odometry/max_speed", &tracker.max_odometry_speed);
   tree.positiveNumber("odometry/max_turn_rate", &tracker.max_odometry_turn_rate);
   tree.number("odometry/wait", &options->odometry_wait, 0.0, 10.0);
@@ -307,6 +326,7 @@ void readOptions(ParamTree& tree, LaserOdometryOptions* options) {
   tree.positiveInteger("mbicp/converged_iterations", &mbicp.converged_iterations);
   tree.fraction("mbicp/min_association_ratio", &mbicp.min_association_ratio);
   tree.fraction("mbicp/degenerate_eigenvalue", &mbicp.degenerate_eigenvalue);
+  tree.nonNegativeNumber("mbicp/independent_points", &mbicp.independent_points);
 
   // Diagnostics.
   tree.nonNegativeNumber("diagnostics/min_rate", &options->diagnostics.min_rate);
@@ -334,6 +354,11 @@ bool checkConsistency(const LaserOdometryOptions& options, std::string* error) {
   if (genetic.tournament_size > genetic.population) {
     return fail("parameter ~genetic/tournament_size must not exceed ~genetic/population (" +
                 std::to_string(genetic.population) + "), got " + std::to_string(genetic.tournament_size));
+  }
+  const hglasm::MotionNoiseOptions& motion = options.tracker.motion;
+  if (motion.max_scale < motion.min_scale) {
+    return fail("parameter ~odometry/noise/max_scale must be at least ~odometry/noise/min_scale (" +
+                formatNumber(motion.min_scale) + "), got " + formatNumber(motion.max_scale));
   }
   const hglasm::ScanConversionOptions& conversion = options.tracker.conversion;
   if (conversion.max_range <= conversion.min_range) {

@@ -1,4 +1,5 @@
-// Laser odometry: keyframes, prediction (wheel odometry or constant velocity), failure policy.
+// Laser odometry: each scan's pose is the maximum a posteriori estimate of the scan matched against a
+// local map of keyframes and the motion predicted by wheel odometry (or a constant velocity).
 #pragma once
 
 #include <Eigen/Core>
@@ -7,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "hglasm_odometry/core/local_map.h"
+#include "hglasm_odometry/core/motion_model.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
@@ -16,38 +19,49 @@ namespace hglasm {
 
 struct TrackerOptions {
   MatcherOptions matcher;
-  ScanConversionOptions conversion;   ///< applied by callers that convert RangeScans (ROS layer, tools)
+  ScanConversionOptions conversion;  ///< applied by callers that convert RangeScans (ROS layer, tools)
+  LocalMapOptions local_map;
+  MotionNoiseOptions motion;
   double keyframe_distance = 0.30;    ///< metres moved since the keyframe that make a new keyframe
   double keyframe_angle = 0.20;       ///< radians turned since the keyframe that make a new keyframe
   double keyframe_min_fitness = 0.0;  ///< a match below this fitness ratio makes the scan a keyframe
-  double min_fitness = 0.15;          ///< a match below this fitness ratio counts as failed
+  double min_fitness = 0.15;          ///< a match whose pose scores below this fitness ratio has failed
   int min_points = 20;                ///< scans with fewer valid points are not matched
-  double fallback_covariance_scale = 100.0;  ///< covariance inflation of a fallback step
+  double fallback_covariance_scale = 100.0;  ///< covariance inflation of a step whose match failed
   double odometry_max_extrapolation = 0.25;  ///< seconds; beyond, wheel odometry counts as stale
-  double max_time_jump = 60.0;        ///< seconds forward between scans that triggers a reset
+  double max_time_jump = 60.0;               ///< seconds forward between scans that triggers a reset
   bool use_odometry = true;
   /// Motion-compensate each scan with the current velocity estimate when its beams' times are known
   /// (Scan::time_increment): a sweep taken while moving is sheared, which a match reads as a small turn.
   bool deskew = true;
   /// Wheel odometry implying faster motion than this between two scans is implausible (a jump): the
   /// constant-velocity prediction is used instead. A margin of 0.2 m / 0.2 rad is added for jitter.
-  double max_odometry_speed = 5.0;       ///< m/s
-  double max_odometry_turn_rate = 6.0;   ///< rad/s
-  /// A match farther than jump_distance + jump_fraction * |predicted motion| (or jump_angle +
-  /// jump_fraction * |predicted turn|) from an odometry or constant-velocity prediction is checked: MbICP
-  /// alone refines the prediction too, and the pre-aligned result is kept only if it fits the reference
-  /// better by jump_margin (fitness ratio). Stops the GA from leaping to a look-alike place (a corridor).
-  double jump_distance = 0.20;      ///< metres
-  double jump_angle = 0.15;         ///< radians
-  double jump_fraction = 0.25;
-  double jump_margin = 0.02;
-  /// A far match is kept only if its fitness ratio also reaches this fraction of the recent matches'
-  /// (a running mean): a leap needs strong evidence. If MbICP from the prediction strays as far, the
-  /// scene is not trustworthy (a crowd, a door swinging) and the prediction is integrated instead.
-  double jump_min_relative_fitness = 0.0;
-  /// Odometry translation noise per metre and rotation noise per radian (for the guess covariance).
-  double odometry_noise_xy = 0.05;
-  double odometry_noise_theta = 0.05;
+  double max_odometry_speed = 5.0;      ///< m/s
+  double max_odometry_turn_rate = 6.0;  ///< rad/s
+  /// Fuse the scan with the predicted motion (its prior inside the refinement, the search sized by it,
+  /// leaps tested). false: the match replaces the prediction, which only centres the preset's box (the
+  /// behaviour before fusion; for comparison).
+  bool fusion = true;
+  /// The GA searches this many standard deviations of the prediction around it on each axis, at least
+  /// min_search_xy / min_search_theta and at most the preset's box, and with the GA size of the smallest
+  /// of the papers' presets whose box holds that (never more than the configured preset's): the preset is
+  /// the robot's worst case, the common case costs less.
+  double search_sigmas = 4.0;
+  double min_search_xy = 0.10;     ///< metres
+  double min_search_theta = 0.05;  ///< radians
+  /// The prediction is in doubt when the match (or where the scan alone would put the pose) lies farther
+  /// from it than this Mahalanobis distance (3 degrees of freedom), or nothing fits near it. Then a second
+  /// hypothesis is searched, "the prediction is wrong" (wheel slip, a glitch, a kidnap): the preset's whole
+  /// box with a prior as wide, and the two matches compete by posterior probability: the scan's likelihood
+  /// (of its independent points) times each hypothesis' prior. A leap thus needs the evidence to outweigh
+  /// the odds against it.
+  double max_mahalanobis = 4.0;
+  /// Probability that a prediction is wrong beyond its noise model (prior odds of a leap per scan)...
+  double leap_probability = 1e-3;
+  /// ... and that it stays wrong at the next scan once it was (wheels slip in bursts, a glitch lasts).
+  double leap_persistence = 0.5;
+  /// Outlier share of the scan likelihood that weighs leaps: a point far from the map costs log(outlier).
+  double likelihood_outlier = 0.1;
 };
 
 enum class PredictionSource { kOdometry, kConstantVelocity, kNone };
@@ -56,23 +70,34 @@ const char* toString(PredictionSource source);
 /// What happened to one scan.
 struct TrackerUpdate {
   double stamp = 0.0;
-  bool published = false;     ///< false only for scans that carry no pose (first scan is published)
-  Pose2D pose;                ///< base frame in the odometry frame
+  bool published = false;  ///< false only for scans that carry no pose (first scan is published)
+  Pose2D pose;             ///< base frame in the odometry frame
   Eigen::Matrix3d pose_covariance = Eigen::Matrix3d::Zero();
+  /// Covariance of the motion since the previous published pose, in that pose's frame (x, y, theta): the
+  /// uncertainty this scan adds; pose_covariance is these composed.
+  Eigen::Matrix3d increment_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< vx, vy, wz in the base frame
   Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Identity();
-  MatchResult match;          ///< raw matcher output (laser frame, keyframe reference)
-  Pose2D guess;               ///< predicted pose of the base (odometry frame) before matching
+  MatchResult match;           ///< raw matcher output (laser frame, local map's frame)
+  double fitness_ratio = 0.0;  ///< fitness ratio of the scan at the estimated pose (fine table)
+  Pose2D guess;                ///< predicted pose of the base (odometry frame) before matching
   PredictionSource prediction = PredictionSource::kNone;
-  bool matched = false;       ///< a match was attempted (false for the first scan and after resets)
-  bool fallback = false;      ///< match failed: the prediction was integrated instead
-  bool jump_rejected = false; ///< the pre-aligned match strayed from the prediction and lost to it
-  bool deskewed = false;      ///< the scan was motion-compensated before matching
+  SearchEffort search;              ///< box and GA size the scan was searched with
+  double prior_mahalanobis = 0.0;   ///< Mahalanobis distance of the match from the prediction
+  bool matched = false;             ///< a match was attempted (false for the first scan and after resets)
+  bool fallback = false;            ///< match failed: the prediction was integrated instead
+  bool prediction_doubted = false;  ///< the match left the prediction: the preset's box was searched too
+  bool leap = false;                ///< the estimate leapt from the prediction with the evidence for it
+  double leap_probability = 0.0;    ///< posterior probability that the prediction was wrong
+  bool jump_rejected = false;  ///< a match far from the prediction lacked the evidence: the prediction held
+  bool deskewed = false;       ///< the scan was motion-compensated before matching
   bool new_keyframe = false;
-  double table_build_ms = 0.0;  ///< lookup-table build of the new keyframe (wall ms; 0 if none)
+  double table_build_ms = 0.0;  ///< lookup-table build of the new local map (wall ms; 0 if none)
   int keyframe_id = 0;
-  bool reset = false;         ///< the tracker restarted (time jump, first scan after reset())
-  std::string warning;        ///< non-empty: one line for the log
+  int map_keyframes = 0;         ///< keyframes in the local map the scan was matched against
+  MotionNoiseScale noise_scale;  ///< the wheel-noise scales learned so far
+  bool reset = false;            ///< the tracker restarted (time jump, first scan after reset())
+  std::string warning;           ///< non-empty: one line for the log
 };
 
 /// Not thread-safe per instance; instances share nothing.
@@ -89,46 +114,99 @@ class OdometryTracker {
 
   /// Processes one scan (points in the laser frame) taken at `stamp` (seconds). If `population_out` is
   /// given, it receives the GA's final population as base poses in the odometry frame (for display).
-  TrackerUpdate processScan(double stamp, const Scan& scan,
-                            std::vector<Pose2D>* population_out = nullptr);
+  TrackerUpdate processScan(double stamp, const Scan& scan, std::vector<Pose2D>* population_out = nullptr);
 
   /// Makes the next processed scan a keyframe (e.g. the scanner's geometry changed).
   void requestKeyframe() { keyframe_requested_ = true; }
 
-  /// Restarts from the identity pose with no keyframe (odometry history kept).
+  /// Restarts from the identity pose with an empty map (odometry history and learned noise kept).
   void reset();
 
   const Pose2D& pose() const { return pose_; }
   const TrackerOptions& options() const { return options_; }
   int keyframeId() const { return keyframe_id_; }
+  const LocalMap& localMap() const { return local_map_; }
 
  private:
-  PredictionSource predict(double stamp, Pose2D* predicted, std::string* warning) const;
-  void guardAgainstJump(const Scan& scan, const Pose2D& laser_guess, PredictionSource prediction,
-                        TrackerUpdate* update);
-  void setKeyframe(const Scan& scan, const Pose2D& pose,
-                   const Eigen::Matrix3d& covariance);
+  /// The predicted motion of the base since the last scan, in the base frame, and its noise.
+  struct Prediction {
+    PredictionSource source = PredictionSource::kNone;
+    Pose2D motion;
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d nominal_covariance = Eigen::Matrix3d::Zero();  ///< wheels at unit noise scale
+  };
+  /// The new pose: the laser in the local map's frame, with its covariance there, and the covariance of
+  /// the base's increment since the last scan.
+  struct Estimate {
+    Pose2D laser_in_map;
+    Eigen::Matrix3d map_covariance = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d increment_covariance = Eigen::Matrix3d::Zero();
+  };
+  /// A match and how well it explains the scan.
+  struct Candidate {
+    MatchResult match;
+    double fitness_ratio = 0.0;  ///< of the scan at the match's pose
+    bool acceptable = false;
+    double mahalanobis_sq = 0.0;
+    double log_posterior = 0.0;
+  };
+
+  bool handleTime(double stamp, TrackerUpdate* update);
+  void initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update);
+  Prediction predict(double stamp, std::string* warning) const;
+  /// Match against the local map with the prediction as prior; false if the prediction is integrated.
+  bool matchScan(const Scan& scan, const Prediction& prediction, std::vector<Pose2D>* population_out,
+                 TrackerUpdate* update, Estimate* estimate);
+  SearchEffort searchEffort(const Eigen::Matrix3d& prior_covariance, bool have_prior) const;
+  Candidate evaluate(const Scan& scan, const MatchResult& match, const PosePrior& prior) const;
+  /// Whether the tight match (or the scan alone) disagrees with the prediction beyond its noise.
+  bool predictionInDoubt(const Candidate& tight, const PosePrior& prior,
+                         const Eigen::Matrix3d& prior_covariance) const;
+  /// log p(scan | pose), of the scan's independent points (on the lookup table as a likelihood field).
+  double scanLogLikelihood(const Scan& scan, const Pose2D& pose) const;
+  /// log of the normal density of `pose` under a prior.
+  static double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3d& covariance);
+  /// Learns the wheels' noise from the wheel increment against the scans' own increment.
+  void learnNoise(const Prediction& prediction, const MatchResult& match);
+  Estimate integratePrediction(const Prediction& prediction) const;
+  void updateVelocity(double stamp, const Pose2D& new_pose, TrackerUpdate* update);
+  void updateKeyframe(const Scan& scan, bool usable, TrackerUpdate* update);
+  void addKeyframe(const Scan& scan);
+
+  Pose2D toMap(const Pose2D& base_pose) const;
+  Pose2D fromMap(const Pose2D& laser_in_map) const;
 
   TrackerOptions options_;
   ScanMatcher matcher_;
   OdometryBuffer odometry_;
+  MotionNoiseModel noise_;
+  LocalMap local_map_;
   Pose2D laser_mount_;
 
   bool initialised_ = false;
   double last_stamp_ = 0.0;
   Pose2D pose_;
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d map_covariance_ = Eigen::Matrix3d::Zero();  // of the laser pose in the local map's frame
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
-  double recent_fitness_ = 0.0;  // running mean of accepted matches' fitness ratios (0: none yet)
   bool velocity_valid_ = false;
+  double prediction_wrong_ = 0.0;  // probability that the last scan's prediction was wrong (a leap)
+  /// Mean and variance of recent values, exponentially forgotten.
+  struct RunningStats {
+    int count = 0;
+    double mean = 0.0;
+    double variance = 0.0;
+    void add(double value);
+  };
+  RunningStats fitness_;  // of accepted matches: how well scans usually fit the map
+  bool have_scan_only_pose_ = false;
+  Pose2D scan_only_pose_;  // base pose in the odometry frame where the last scan alone put it
 
   std::deque<StampedPose> history_;  // recent poses, for the velocity
-  bool has_keyframe_ = false;
   bool keyframe_requested_ = false;
   int keyframe_id_ = 0;
   int keyframe_beam_count_ = 0;
-  Pose2D keyframe_pose_;
-  Eigen::Matrix3d keyframe_covariance_ = Eigen::Matrix3d::Zero();
+  Pose2D keyframe_pose_;  // base pose of the newest keyframe
 };
 
 }  // namespace hglasm
