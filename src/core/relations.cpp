@@ -1,6 +1,7 @@
 // The Kümmerle et al. 2009 relations metric.
 #include "hglasm_odometry/core/relations.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -117,6 +118,63 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
   };
   moments(trans_errors, &stats.trans_mean, &stats.trans_std, &stats.trans_sq_mean);
   moments(rot_errors_deg, &stats.rot_mean_deg, &stats.rot_std_deg, &stats.rot_sq_mean_deg);
+  return stats;
+}
+
+std::vector<RelationError> relationErrors(const std::vector<Relation>& relations,
+                                          const std::vector<StampedPose>& trajectory, double max_span,
+                                          double stamp_tolerance) {
+  std::vector<RelationError> errors;
+  for (std::size_t k = 0; k < relations.size(); ++k) {
+    const Relation& relation = relations[k];
+    if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
+    const long i1 = findStamp(trajectory, relation.t1, stamp_tolerance);
+    const long i2 = findStamp(trajectory, relation.t2, stamp_tolerance);
+    if (i1 < 0 || i2 < 0) continue;
+    const Pose2D residual =
+        relativePose(relation.motion, relativePose(trajectory[i1].pose, trajectory[i2].pose));
+    errors.push_back({k, residual.translationNorm(), std::abs(normalizeAngle(residual.theta)) * kRadToDeg});
+  }
+  return errors;
+}
+
+CalibrationStats evaluateCalibration(const std::vector<Relation>& relations,
+                                     const std::vector<StampedPose>& trajectory,
+                                     const std::vector<Eigen::Matrix3d>& increment_covariances,
+                                     double max_span, double stamp_tolerance) {
+  CalibrationStats stats;
+  if (increment_covariances.size() != trajectory.size()) return stats;
+  std::vector<double> distances;
+  for (const Relation& relation : relations) {
+    if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
+    const long i1 = findStamp(trajectory, relation.t1, stamp_tolerance);
+    const long i2 = findStamp(trajectory, relation.t2, stamp_tolerance);
+    if (i1 < 0 || i2 <= i1) continue;
+    Pose2D motion;
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (long i = i1 + 1; i <= i2; ++i) {
+      const Pose2D step = relativePose(trajectory[i - 1].pose, trajectory[i].pose);
+      covariance = composeCovariance(motion, covariance, step, increment_covariances[i]);
+      motion = motion * step;
+    }
+    const Eigen::Vector3d error(motion.x - relation.motion.x, motion.y - relation.motion.y,
+                                normalizeAngle(motion.theta - relation.motion.theta));
+    const Eigen::Matrix3d regularised = covariance + Eigen::Matrix3d::Identity() * 1e-12;
+    const double distance = error.dot(regularised.ldlt().solve(error));
+    if (std::isfinite(distance)) distances.push_back(distance);
+  }
+  stats.count = static_cast<int>(distances.size());
+  if (distances.empty()) return stats;
+  double sum = 0.0;
+  int within = 0;
+  for (double distance : distances) {
+    sum += distance;
+    within += distance <= 7.81;
+  }
+  stats.mean_sq_mahalanobis = sum / distances.size();
+  stats.fraction_within_3dof_95 = static_cast<double>(within) / distances.size();
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  stats.median_sq_mahalanobis = distances[distances.size() / 2];
   return stats;
 }
 

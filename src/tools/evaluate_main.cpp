@@ -36,7 +36,9 @@ const char kUsage[] =
     "  --presets Y             default presets.yaml next to --config (loaded under ~presets)\n"
     "  --preset P              small | medium | large or a preset of --presets (default: the YAML's)\n"
     "  --relations R           Kümmerle et al. relations file: print the benchmark metric\n"
-    "  --out F                 write the trajectory, 'stamp x y theta' per scan (base frame)\n"
+    "  --out F                 write the trajectory, 'stamp x y theta' per scan (base frame), then the\n"
+    "                          increment covariance since the previous scan (xx xy xt yy yt tt)\n"
+    "  --trace F               write one line per scan: what the tracker decided and why\n"
     "  --plot F.png            plot laser and wheel odometry trajectories (gnuplot)\n"
     "  --no-odom               do not feed wheel odometry to the tracker (constant-velocity prior)\n"
     "  --odom-lookahead S      feed odometry stamped up to S s after each scan (default 0: as live)\n"
@@ -62,6 +64,7 @@ struct Arguments {
   std::string preset;
   std::string relations;
   std::string out;
+  std::string trace;
   std::string plot;
   bool use_odometry = true;
   double odom_lookahead = 0.0;
@@ -122,6 +125,8 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
       if (!value(&args->relations)) return false;
     } else if (flag == "--out") {
       if (!value(&args->out)) return false;
+    } else if (flag == "--trace") {
+      if (!value(&args->trace)) return false;
     } else if (flag == "--plot") {
       if (!value(&args->plot)) return false;
     } else if (flag == "--no-odom") {
@@ -280,11 +285,40 @@ bool wheelPoseAt(const std::vector<hglasm_odometry::BagOdometry>& odometry, doub
   return true;
 }
 
-bool writeTrajectory(const std::string& path, const std::vector<hglasm::StampedPose>& trajectory) {
+/// 'stamp x y theta' per pose; with `updates` (one per pose) also the increment covariance since the
+/// previous pose, 'xx xy xtheta yy ytheta thetatheta', in that pose's frame.
+bool writeTrajectory(const std::string& path, const std::vector<hglasm::StampedPose>& trajectory,
+                     const std::vector<hglasm::TrackerUpdate>* updates = nullptr) {
   std::FILE* file = std::fopen(path.c_str(), "w");
   if (!file) return false;
-  for (const auto& pose : trajectory) {
-    std::fprintf(file, "%.6f %.6f %.6f %.6f\n", pose.stamp, pose.pose.x, pose.pose.y, pose.pose.theta);
+  for (std::size_t i = 0; i < trajectory.size(); ++i) {
+    const auto& pose = trajectory[i];
+    std::fprintf(file, "%.6f %.6f %.6f %.6f", pose.stamp, pose.pose.x, pose.pose.y, pose.pose.theta);
+    if (updates && i < updates->size()) {
+      const Eigen::Matrix3d& c = (*updates)[i].increment_covariance;
+      std::fprintf(file, " %.6g %.6g %.6g %.6g %.6g %.6g", c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2));
+    }
+    std::fprintf(file, "\n");
+  }
+  return std::fclose(file) == 0;
+}
+
+/// One line per scan: the tracker's decisions (see the header line).
+bool writeTrace(const std::string& path, const std::vector<hglasm::TrackerUpdate>& updates) {
+  std::FILE* file = std::fopen(path.c_str(), "w");
+  if (!file) return false;
+  std::fprintf(file,
+               "# stamp x y theta prediction matched fallback doubted leap rejected keyframe map_keyframes "
+               "box_x box_y box_theta population mahalanobis fitness status mbicp_iterations noise_xy "
+               "noise_theta guess_x guess_y guess_theta leap_probability vx vy wz\n");
+  for (const auto& u : updates) {
+    std::fprintf(file, "%.6f %.4f %.4f %.5f %s %d %d %d %d %d %d %d %.3f %.3f %.3f %d %.2f %.3f %s %d %.3g %.3g %.4f %.4f %.5f %.3g %.4f %.4f %.4f\n",
+                 u.stamp, u.pose.x, u.pose.y, u.pose.theta, hglasm::toString(u.prediction), u.matched, u.fallback,
+                 u.prediction_doubted, u.leap, u.jump_rejected, u.new_keyframe, u.map_keyframes, u.search.box.half_x,
+                 u.search.box.half_y, u.search.box.half_theta, u.search.population, u.prior_mahalanobis,
+                 u.fitness_ratio, hglasm::toString(u.match.status), u.match.iterations, u.noise_scale.xy,
+                 u.noise_scale.theta, u.guess.x, u.guess.y, u.guess.theta, u.leap_probability,
+                 u.velocity.x(), u.velocity.y(), u.velocity.z());
   }
   return std::fclose(file) == 0;
 }
@@ -353,6 +387,7 @@ struct Run {
   std::string beam_times;  ///< where the first scan's beam times came from
   std::map<std::string, int> statuses, predictions;
   std::vector<double> total_ms, convert_ms, prealign_ms, refine_ms, table_ms;
+  std::vector<hglasm::TrackerUpdate> updates;  ///< every published scan's update, in order
 };
 
 /// The tracker's scan conversion for this bag: an upside-down laser's scans are mirrored.
@@ -429,7 +464,10 @@ Run runTracker(const Arguments& args, const hglasm::TrackerOptions& options,
     if (!update.warning.empty() && ++run.warnings <= 20 && !args.quiet) {
       std::printf("  warning at %.6f: %s\n", bag_scan.stamp, update.warning.c_str());
     }
-    if (update.published) run.trajectory.push_back({bag_scan.stamp, update.pose});
+    if (update.published) {
+      run.trajectory.push_back({bag_scan.stamp, update.pose});
+      run.updates.push_back(update);
+    }
   }
   return run;
 }
@@ -446,6 +484,23 @@ void printRun(const Run& run, double data_seconds) {
   for (const auto& entry : run.statuses) std::printf(" %s %d", entry.first.c_str(), entry.second);
   std::printf("\nprediction   ");
   for (const auto& entry : run.predictions) std::printf(" %s %d", entry.first.c_str(), entry.second);
+  int rejected = 0, doubted = 0, leaps = 0, small_searches = 0;
+  double map_keyframes = 0.0;
+  for (const auto& update : run.updates) {
+    rejected += update.jump_rejected;
+    doubted += update.prediction_doubted;
+    leaps += update.leap;
+    if (update.matched) {
+      small_searches += update.search.population <= hglasm::presetOptions(hglasm::Preset::kSmall).genetic.population;
+      map_keyframes += update.map_keyframes;
+    }
+  }
+  const hglasm::MotionNoiseScale noise = run.updates.empty() ? hglasm::MotionNoiseScale() : run.updates.back().noise_scale;
+  std::printf("\nfusion        prediction doubted %d times: %d leaps taken, %d rejected; %d of %d searches "
+              "small-sized, %.1f keyframes per map; wheel noise scale learned: xy %.3g, theta %.3g",
+              doubted, leaps, rejected, small_searches, run.matched, run.matched ? map_keyframes / run.matched : 0.0,
+              noise.xy, noise.theta);
+
   std::printf("\n\nms per scan                     scans   median      p99      max  mean/scan\n");
   const auto row = [scans](const char* label, const Spread& spread) {
     std::printf("  %-29s %6zu %8.3f %8.3f %8.3f %8.3f\n", label, spread.count, spread.median, spread.p99,
@@ -508,6 +563,40 @@ void directPairs(const Arguments& args, const hglasm::TrackerOptions& options,
   }
 }
 
+/// Prints the short relations with the largest translational errors beside the wheels' errors on them,
+/// and returns the largest ratio laser error / (3 x wheel error + 0.10 m) over them: above 1 is a leap the
+/// wheels did not make.
+double printWorstRelations(const std::vector<hglasm::Relation>& relations,
+                           const std::vector<hglasm::StampedPose>& trajectory,
+                           const std::vector<hglasm::StampedPose>& wheel_trajectory, double max_span) {
+  std::vector<hglasm::RelationError> laser = hglasm::relationErrors(relations, trajectory, max_span);
+  const std::vector<hglasm::RelationError> wheel = hglasm::relationErrors(relations, wheel_trajectory, max_span);
+  std::map<std::size_t, hglasm::RelationError> wheel_by_index;
+  for (const auto& error : wheel) wheel_by_index[error.index] = error;
+  double worst_ratio = 0.0;
+  for (const auto& error : laser) {
+    const auto it = wheel_by_index.find(error.index);
+    if (it == wheel_by_index.end()) continue;
+    worst_ratio = std::max(worst_ratio, error.trans / (3.0 * it->second.trans + 0.10));
+  }
+  std::sort(laser.begin(), laser.end(), [](const auto& a, const auto& b) { return a.trans > b.trans; });
+  std::printf("  worst relations <= %g s (t1, span; laser m / deg | wheel m / deg):\n", max_span);
+  for (std::size_t k = 0; k < std::min<std::size_t>(5, laser.size()); ++k) {
+    const hglasm::Relation& relation = relations[laser[k].index];
+    const auto it = wheel_by_index.find(laser[k].index);
+    std::printf("    %.3f +%.2f s  %.4f / %6.3f | ", relation.t1, relation.t2 - relation.t1, laser[k].trans,
+                laser[k].rot_deg);
+    if (it != wheel_by_index.end()) {
+      std::printf("%.4f / %6.3f\n", it->second.trans, it->second.rot_deg);
+    } else {
+      std::printf("-\n");
+    }
+  }
+  std::printf("  largest laser / (3 x wheel + 0.10 m) over relations <= %g s: %.3f (above 1: a leap)\n", max_span,
+              worst_ratio);
+  return worst_ratio;
+}
+
 void printRelations(const Arguments& args, const std::string& preset_name, const Run& run,
                     const std::vector<hglasm::Relation>& relations,
                     const std::vector<hglasm::StampedPose>& wheel_trajectory,
@@ -552,6 +641,15 @@ void printRelations(const Arguments& args, const std::string& preset_name, const
                 short_label, direct.count, direct.missing, direct.trans_mean, direct.trans_std,
                 direct.rot_mean_deg, direct.rot_std_deg);
   }
+  std::vector<Eigen::Matrix3d> increments;
+  for (const auto& update : run.updates) increments.push_back(update.increment_covariance);
+  const hglasm::CalibrationStats calibration =
+      hglasm::evaluateCalibration(relations, run.trajectory, increments, args.short_span);
+  std::printf("  calibration %s: mean squared Mahalanobis distance %.2f (3 = honest covariances), median %.2f, "
+              "%.1f %% within the 95 %% bound (%d relations)\n",
+              short_label, calibration.mean_sq_mahalanobis, calibration.median_sq_mahalanobis,
+              100.0 * calibration.fraction_within_3dof_95, calibration.count);
+  const double worst_leap = printWorstRelations(relations, run.trajectory, wheel_trajectory, args.short_span);
   // One machine-readable line for scripts/evaluate_all.sh.
   const Spread total = spreadOf(run.total_ms);
   const std::size_t scans = run.processed;
@@ -559,11 +657,12 @@ void printRelations(const Arguments& args, const std::string& preset_name, const
       "SUMMARY preset=%s scans=%zu fallbacks=%d fallback_pct=%.3f cpu_median_ms=%.3f cpu_p99_ms=%.3f "
       "cpu_max_ms=%.3f all_t=%.4f all_r=%.3f short_t=%.4f short_r=%.3f wheel_all_t=%.4f "
       "wheel_all_r=%.3f wheel_short_t=%.4f wheel_short_r=%.3f laser_frame_short_t=%.4f "
-      "laser_frame_short_r=%.3f\n",
+      "laser_frame_short_r=%.3f calibration=%.3f worst_leap=%.3f\n",
       preset_name.c_str(), scans, run.fallbacks, scans ? 100.0 * run.fallbacks / scans : 0.0, total.median,
       total.p99, total.max, laser_all.trans_mean, laser_all.rot_mean_deg, laser_short.trans_mean,
       laser_short.rot_mean_deg, wheel_all.trans_mean, wheel_all.rot_mean_deg, wheel_short.trans_mean,
-      wheel_short.rot_mean_deg, laser_frame_short.trans_mean, laser_frame_short.rot_mean_deg);
+      wheel_short.rot_mean_deg, laser_frame_short.trans_mean, laser_frame_short.rot_mean_deg,
+      calibration.mean_sq_mahalanobis, worst_leap);
 }
 
 }  // namespace
@@ -631,11 +730,18 @@ int main(int argc, char** argv) {
     printRelations(args, nodelet_options.preset, run, relations, wheel_trajectory, options, data);
 
   if (!args.out.empty()) {
-    if (!writeTrajectory(args.out, run.trajectory)) {
+    if (!writeTrajectory(args.out, run.trajectory, &run.updates)) {
       std::cerr << "evaluate: cannot write " << args.out << "\n";
       return 1;
     }
     std::printf("trajectory    %s (%zu poses)\n", args.out.c_str(), run.trajectory.size());
+  }
+  if (!args.trace.empty()) {
+    if (!writeTrace(args.trace, run.updates)) {
+      std::cerr << "evaluate: cannot write " << args.trace << "\n";
+      return 1;
+    }
+    std::printf("trace         %s\n", args.trace.c_str());
   }
   if (!args.plot.empty()) {
     const std::string title =

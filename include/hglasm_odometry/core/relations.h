@@ -1,6 +1,8 @@
 // The Kümmerle et al. 2009 relations metric: errors of estimated relative motions against reference ones.
 #pragma once
 
+#include <Eigen/Core>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -41,5 +43,36 @@ RelationStats evaluateRelations(const std::vector<Relation>& relations,
 RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
                                       const std::vector<Pose2D>& estimated, const std::vector<bool>& valid,
                                       double max_span);
+
+/// One relation's error (the residual estimated ⊖ reference).
+struct RelationError {
+  std::size_t index = 0;  ///< into the relations
+  double trans = 0.0;     ///< metres
+  double rot_deg = 0.0;   ///< absolute, degrees
+};
+
+/// Per-relation errors of the relations spanning at most `max_span` s (<= 0: all) whose stamps are in
+/// `trajectory`, in the order of `relations`.
+std::vector<RelationError> relationErrors(const std::vector<Relation>& relations,
+                                          const std::vector<StampedPose>& trajectory, double max_span,
+                                          double stamp_tolerance = 1e-3);
+
+/// How well a trajectory's stated uncertainty covers its errors: for each relation, the per-step increment
+/// covariances from t1 to t2 composed (the covariance of the estimated relative motion) against the error
+/// of that motion (coordinates in the t1 frame). With honest covariances the squared Mahalanobis distance
+/// averages 3 (three degrees of freedom).
+struct CalibrationStats {
+  int count = 0;
+  double mean_sq_mahalanobis = 0.0;
+  double median_sq_mahalanobis = 0.0;
+  double fraction_within_3dof_95 = 0.0;  ///< share of relations with squared distance <= 7.81
+};
+
+/// `increment_covariances[i]` is the covariance of the motion from trajectory[i-1] to trajectory[i] in
+/// trajectory[i-1]'s frame (element 0 unused).
+CalibrationStats evaluateCalibration(const std::vector<Relation>& relations,
+                                     const std::vector<StampedPose>& trajectory,
+                                     const std::vector<Eigen::Matrix3d>& increment_covariances,
+                                     double max_span, double stamp_tolerance = 1e-3);
 
 }  // namespace hglasm
