@@ -188,4 +188,8 @@ bool readBag(const std::string& path, const BagReadOptions& options, BagData* da
   return true;
 }
 
+void setLaserMount(const BagData& data, hglasm::OdometryPipeline* pipeline) {
+  if (data.has_laser_mount) pipeline->setLaserMount(data.base_to_laser, data.laser_upside_down);
+}
+
 }  // namespace hglasm_odometry
