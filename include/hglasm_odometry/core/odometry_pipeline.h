@@ -71,7 +71,9 @@ class OdometryPipeline {
   /// Offline replay of recorded odometry, under the feeding policy: adds the samples [next, end) (sorted
   /// by stamp; each with .stamp and .pose) that a live node holds when it processes a scan at `stamp`:
   /// every sample stamped at or before it, then later ones until odometryReadyFor(stamp). Returns the
-  /// first sample not added. Adds nothing when odometry is off.
+  /// first sample not added. Adds nothing when odometry is off. Assumes no live wait timed out; and a
+  /// sample stamped exactly at `stamp` may round an ulp differently from a live buffer that already holds a
+  /// later one (OdometryBuffer extrapolates by 0 s there instead of interpolating).
   template <typename Iterator>
   Iterator addRecordedOdometry(Iterator next, Iterator end, double stamp) {
     if (!tracker_.options().use_odometry) return end;
