@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Memory check over full replays (issue 5; too slow for CI, run by hand, ~5 min):
 #   1. valgrind memcheck (leak-check=full) over `evaluate` on the whole fr079 bag (4934 scans): the same
-#      OdometryTracker pipeline as the nodelet, without ROS. Expect: no errors, nothing definitely or
+#      OdometryPipeline as the nodelet, without ROS. Expect: no errors, nothing definitely or
 #      indirectly lost.
 #   2. peak resident memory of the same run without valgrind (/usr/bin/time -v).
 #   3. laser_odometry_node under heaptrack (or valgrind: NODE_TOOL=valgrind) while `rosbag play` replays

@@ -89,7 +89,7 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
       name_(private_nh.getNamespace()),
       nh_(nh),
       private_nh_(private_nh),
-      tracker_(options.tracker),
+      pipeline_(options.tracker, options.odometry_wait > 0.0),
       tf_listener_(tf_buffer_),
       diagnostics_(nh, private_nh, private_nh.getNamespace()) {
   // Outputs first, inputs last: nothing arrives before there is somewhere to publish it.
@@ -132,7 +132,7 @@ LaserOdometry::~LaserOdometry() {
     stop_ = true;
   }
   queue_cv_.notify_all();
-  odom_stamp_cv_.notify_all();
+  odometry_cv_.notify_all();
   if (worker_.joinable()) worker_.join();
 }
 
@@ -165,31 +165,25 @@ void LaserOdometry::odomCallback(const nav_msgs::OdometryConstPtr& msg) {
                         << "\"; it is used as the motion of base_frame anyway");
   }
   {
-    std::lock_guard<std::mutex> lock(tracker_mutex_);
-    tracker_.addOdometry(msg->header.stamp.toSec(), pose);
+    std::lock_guard<std::mutex> lock(pipeline_mutex_);
+    pipeline_.addOdometry(msg->header.stamp.toSec(), pose);
   }
-  {
-    std::lock_guard<std::mutex> lock(odom_stamp_mutex_);
-    if (msg->header.stamp > newest_odom_stamp_) newest_odom_stamp_ = msg->header.stamp;
-  }
-  odom_stamp_cv_.notify_all();
+  odometry_cv_.notify_all();
 }
 
-void LaserOdometry::waitForOdometry(const ros::Time& stamp) {
-  // Odometry that stopped (or never came) is not waited for: the tracker falls back to its prediction.
-  constexpr double kStoppedAfter = 1.0;  // seconds of scan time without odometry
-  std::unique_lock<std::mutex> lock(odom_stamp_mutex_);
-  if (newest_odom_stamp_.isZero() || (stamp - newest_odom_stamp_).toSec() > kStoppedAfter) return;
-  odom_stamp_cv_.wait_for(lock, std::chrono::duration<double>(options_.odometry_wait), [this, &stamp] {
+void LaserOdometry::waitForOdometry(double stamp) {
+  std::unique_lock<std::mutex> lock(pipeline_mutex_);
+  odometry_cv_.wait_for(lock, std::chrono::duration<double>(options_.odometry_wait), [this, stamp] {
+    if (pipeline_.odometryReadyFor(stamp)) return true;
     std::lock_guard<std::mutex> queue_lock(queue_mutex_);
-    return stop_ || newest_odom_stamp_ >= stamp;
+    return stop_;
   });
 }
 
 bool LaserOdometry::resetCallback(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   {
-    std::lock_guard<std::mutex> lock(tracker_mutex_);
-    tracker_.reset();
+    std::lock_guard<std::mutex> lock(pipeline_mutex_);
+    pipeline_.reset();
   }
   ROS_INFO_STREAM("[" << name_ << "] reset requested: restarting from the origin at the next scan");
   return true;
@@ -244,10 +238,9 @@ bool LaserOdometry::ensureLaserMount(const std::string& laser_frame) {
   waiting_for_tf_ = false;
   have_mount_ = true;
   mount_frame_ = laser_frame;
-  mount_ = mount;
   {
-    std::lock_guard<std::mutex> lock(tracker_mutex_);
-    tracker_.setLaserMount(mount.base_to_laser);
+    std::lock_guard<std::mutex> lock(pipeline_mutex_);
+    pipeline_.setLaserMount(mount.base_to_laser, mount.upside_down);
   }
   ROS_INFO_STREAM("[" << name_ << "] scan frame \"" << laser_frame << "\" at x " << mount.base_to_laser.x
                       << " m, y " << mount.base_to_laser.y << " m, yaw " << mount.base_to_laser.theta
@@ -288,53 +281,34 @@ void LaserOdometry::workerLoop() {
 }
 
 void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
-  if (options_.use_odom && options_.odometry_wait > 0.0) waitForOdometry(msg.header.stamp);
+  const double stamp = msg.header.stamp.toSec();
+  waitForOdometry(stamp);
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = threadCpuMs();
 
-  hglasm::ScanConversionOptions conversion = options_.tracker.conversion;
-  conversion.mirror = mount_.upside_down;
-  hglasm::ScanError scan_error = hglasm::ScanError::kNone;
-  const hglasm::Scan scan = hglasm::scanFromRanges(rangeScanFromMsg(msg), conversion, &scan_error);
-  if (scan_error != last_scan_error_) {
+  std::vector<hglasm::Pose2D> population;
+  const bool want_population = options_.publish_population && population_pub_.getNumSubscribers() > 0;
+  const hglasm::RangeScan ranges = rangeScanFromMsg(msg);
+  hglasm::PipelineUpdate result;
+  {
+    std::lock_guard<std::mutex> lock(pipeline_mutex_);
+    result = pipeline_.processScan(stamp, ranges, want_population ? &population : nullptr);
+  }
+  const hglasm::TrackerUpdate& update = result.tracker;
+  if (result.scan_error_changed) {
     // One message per change of state, not per scan.
-    if (scan_error != hglasm::ScanError::kNone) {
-      ROS_WARN_STREAM("[" << name_ << "] unusable scan (" << hglasm::toString(scan_error)
+    if (result.scan_error != hglasm::ScanError::kNone) {
+      ROS_WARN_STREAM("[" << name_ << "] unusable scan (" << hglasm::toString(result.scan_error)
                           << "); integrating the prediction until scans are valid again");
     } else {
       ROS_INFO_STREAM("[" << name_ << "] scans are valid again");
     }
-    last_scan_error_ = scan_error;
   }
-
-  std::vector<hglasm::Pose2D> population;
-  const bool want_population = options_.publish_population && population_pub_.getNumSubscribers() > 0;
-  hglasm::TrackerUpdate update;
-  const hglasm::Pose2D keyframe_before = keyframe_pose_;
-  {
-    std::lock_guard<std::mutex> lock(tracker_mutex_);
-    // A changed angular geometry with the same beam count is not visible to the tracker (it compares beam
-    // counts): make this scan a keyframe so it is never matched against a reference of other geometry.
-    if (scan_error == hglasm::ScanError::kNone) {
-      const bool increment_changed = have_last_geometry_ && msg.ranges.size() == last_beam_count_ &&
-                                     std::abs(msg.angle_increment - last_angle_increment_) >
-                                         1e-6 * std::abs(last_angle_increment_) + 1e-9;
-      if (increment_changed) {
-        ROS_WARN_STREAM("[" << name_ << "] scan angle_increment changed from " << last_angle_increment_
-                            << " to " << msg.angle_increment << "; new keyframe");
-        tracker_.requestKeyframe();
-      }
-      have_last_geometry_ = true;
-      last_beam_count_ = msg.ranges.size();
-      last_angle_increment_ = msg.angle_increment;
-    }
-    update = tracker_.processScan(msg.header.stamp.toSec(), scan, want_population ? &population : nullptr);
-  }
+  if (!result.geometry_warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << result.geometry_warning);
   if (!update.warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << update.warning);
   if (update.reset) path_.clear();
-  if (update.new_keyframe) keyframe_pose_ = update.pose;
 
-  publish(msg, update, scan, keyframe_before, msSince(start), update.table_build_ms);
+  publish(msg, result, msSince(start));
   if (want_population && update.matched) publishPopulation(msg.header, update, population);
 
   ScanRecord record;
@@ -352,9 +326,9 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
   }
 }
 
-void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::TrackerUpdate& update,
-                            const hglasm::Scan& scan, const hglasm::Pose2D& keyframe_before, double total_ms,
-                            double table_build_ms) {
+void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::PipelineUpdate& result,
+                            double total_ms) {
+  const hglasm::TrackerUpdate& update = result.tracker;
   const ros::Time stamp = msg.header.stamp;
   if (update.published) {
     const boost::array<double, 36> pose_covariance = covariance6x6FromPlanar(update.pose_covariance);
@@ -417,10 +391,7 @@ void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::Tra
   match.reset = update.reset;
   match.keyframe_id = static_cast<std::uint32_t>(std::max(0, update.keyframe_id));
   if (update.matched) {
-    // The guess as the matcher saw it: the new laser pose in the keyframe's laser frame.
-    const hglasm::Pose2D& mount = mount_.base_to_laser;
-    const hglasm::Pose2D laser_guess = mount.inverse() * relativePose(keyframe_before, update.guess) * mount;
-    match.guess_pose = pose2DMsgFromPose2D(laser_guess);
+    if (result.laser_guess) match.guess_pose = pose2DMsgFromPose2D(*result.laser_guess);
     match.prealigned_pose = pose2DMsgFromPose2D(update.match.prealigned_pose);
     match.final_pose = pose2DMsgFromPose2D(update.match.pose);
   }
@@ -430,9 +401,9 @@ void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::Tra
   match.iterations = static_cast<std::uint32_t>(std::max(0, update.match.iterations));
   match.associations = static_cast<std::uint32_t>(std::max(0, update.match.associations));
   match.rms_error = finiteFloat(update.match.rms_error);
-  match.valid_points = static_cast<std::uint32_t>(scan.size());
-  match.invalid_points = static_cast<std::uint32_t>(std::max(0, scan.invalid_count));
-  match.table_build_ms = finiteFloat(table_build_ms);
+  match.valid_points = static_cast<std::uint32_t>(result.scan.size());
+  match.invalid_points = static_cast<std::uint32_t>(std::max(0, result.scan.invalid_count));
+  match.table_build_ms = finiteFloat(update.table_build_ms);
   match.prealign_ms = finiteFloat(update.match.prealign_ms);
   match.refine_ms = finiteFloat(update.match.refine_ms);
   match.total_ms = finiteFloat(total_ms);

@@ -1,4 +1,4 @@
-// evaluate: runs the nodelet's odometry pipeline (hglasm::OdometryTracker, same options and YAML)
+// evaluate: runs the nodelet's odometry pipeline (hglasm::OdometryPipeline, same options and YAML)
 // over a bag as fast as the CPU allows, without a ROS master, and scores it on the Kümmerle et al.
 // relations benchmark next to the bag's raw wheel odometry.
 #include <stdio.h>
@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "hglasm_odometry/core/odometry_tracker.h"
+#include "hglasm_odometry/core/odometry_pipeline.h"
 #include "hglasm_odometry/core/relations.h"
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
@@ -41,7 +41,6 @@ const char kUsage[] =
     "  --trace F               write one line per scan: what the tracker decided and why\n"
     "  --plot F.png            plot laser and wheel odometry trajectories (gnuplot)\n"
     "  --no-odom               do not feed wheel odometry to the tracker (constant-velocity prior)\n"
-    "  --odom-lookahead S      feed odometry stamped up to S s after each scan (default 0: as live)\n"
     "  --min-scan-interval S   skip scans stamped less than S s after the last processed one\n"
     "  --laser-mount X,Y,YAW   base -> laser (m, m, rad) instead of the bag's tf\n"
     "  --max-scans N           process only the first N scans\n"
@@ -67,7 +66,6 @@ struct Arguments {
   std::string trace;
   std::string plot;
   bool use_odometry = true;
-  double odom_lookahead = 0.0;
   double min_scan_interval = 0.0;
   bool override_mount = false;
   hglasm::Pose2D laser_mount;
@@ -141,8 +139,6 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
     } else if (flag == "--angle-increment") {
       if (!number(&args->angle_increment)) return false;
       args->override_increment = true;
-    } else if (flag == "--odom-lookahead") {
-      if (!number(&args->odom_lookahead)) return false;
     } else if (flag == "--laser-mount") {
       std::string text;
       if (!value(&text)) return false;
@@ -390,12 +386,13 @@ struct Run {
   std::vector<hglasm::TrackerUpdate> updates;  ///< every published scan's update, in order
 };
 
-/// The tracker's scan conversion for this bag: an upside-down laser's scans are mirrored.
-hglasm::ScanConversionOptions conversionFor(const hglasm::TrackerOptions& options,
-                                            const hglasm_odometry::BagData& data) {
-  hglasm::ScanConversionOptions conversion = options.conversion;
-  if (data.laser_upside_down) conversion.mirror = !conversion.mirror;
-  return conversion;
+/// Where the beam times of a scan came from, for the report.
+std::string beamTimesOf(const hglasm::RangeScan& ranges, const hglasm::Scan& scan) {
+  if (scan.time_increment == 0.0) return "not known (time_increment and scan/sweep_time are 0)";
+  char text[96];
+  std::snprintf(text, sizeof text, "%.3g s per beam (%s)", scan.time_increment,
+                ranges.time_increment != 0.0 ? "the bag's time_increment" : "scan/sweep_time");
+  return text;
 }
 
 /// A bag scan's ranges with the command line's beam-angle overrides.
@@ -406,16 +403,15 @@ hglasm::RangeScan rangesOf(const Arguments& args, const hglasm_odometry::BagScan
   return ranges;
 }
 
-/// Feeds the bag to the tracker exactly as the nodelet would: odometry stamped up to each scan first,
-/// then the scan (converted with the tracker's options, mirrored for an upside-down laser).
-Run runTracker(const Arguments& args, const hglasm::TrackerOptions& options,
-               const hglasm_odometry::BagData& data) {
+/// Runs the nodelet's pipeline over the bag: the bag's laser mount, wheel odometry fed under the
+/// pipeline's policy (what the live node holds after its wait for odometry), the scans in stamp order.
+Run runTracker(const Arguments& args, const hglasm_odometry::LaserOdometryOptions& nodelet_options,
+               const hglasm::TrackerOptions& options, const hglasm_odometry::BagData& data) {
   Run run;
-  hglasm::OdometryTracker tracker(options);
-  if (data.has_laser_mount) tracker.setLaserMount(data.base_to_laser);
-  const hglasm::ScanConversionOptions conversion = conversionFor(options, data);
+  hglasm::OdometryPipeline pipeline(options, nodelet_options.odometry_wait > 0.0);
+  hglasm_odometry::setLaserMount(data, &pipeline);
 
-  std::size_t next_odometry = 0;
+  auto next_odometry = data.odometry.begin();
   double last_processed_stamp = -std::numeric_limits<double>::infinity();
   for (const auto& bag_scan : data.scans) {
     if (bag_scan.stamp - last_processed_stamp < args.min_scan_interval) {
@@ -423,26 +419,18 @@ Run runTracker(const Arguments& args, const hglasm::TrackerOptions& options,
       continue;
     }
     last_processed_stamp = bag_scan.stamp;
-    if (options.use_odometry) {
-      const double odometry_until = bag_scan.stamp + args.odom_lookahead;
-      for (; next_odometry < data.odometry.size() && data.odometry[next_odometry].stamp <= odometry_until;
-           ++next_odometry) {
-        tracker.addOdometry(data.odometry[next_odometry].stamp, data.odometry[next_odometry].pose);
-      }
-    }
+    next_odometry = pipeline.addRecordedOdometry(next_odometry, data.odometry.end(), bag_scan.stamp);
     const hglasm::RangeScan ranges = rangesOf(args, bag_scan);
 
     const double start = cpuMs();
-    hglasm::ScanError scan_error = hglasm::ScanError::kNone;
-    const hglasm::Scan scan = hglasm::scanFromRanges(ranges, conversion, &scan_error);
-    const double converted = cpuMs();
-    const hglasm::TrackerUpdate update = tracker.processScan(bag_scan.stamp, scan);
+    const hglasm::PipelineUpdate result = pipeline.processScan(bag_scan.stamp, ranges);
     const double end = cpuMs();
+    const hglasm::TrackerUpdate& update = result.tracker;
 
     ++run.processed;
     run.total_ms.push_back(end - start);
-    run.convert_ms.push_back(converted - start);
-    if (scan_error != hglasm::ScanError::kNone) ++run.conversion_errors;
+    run.convert_ms.push_back(result.conversion_cpu_ms);
+    if (result.scan_error != hglasm::ScanError::kNone) ++run.conversion_errors;
     if (update.matched) {
       ++run.matched;
       run.prealign_ms.push_back(update.match.prealign_ms);
@@ -453,16 +441,13 @@ Run runTracker(const Arguments& args, const hglasm::TrackerOptions& options,
     ++run.predictions[hglasm::toString(update.prediction)];
     run.fallbacks += update.fallback;
     run.deskewed += update.deskewed;
-    if (run.beam_times.empty()) {
-      char text[96];
-      std::snprintf(text, sizeof text, "%.3g s per beam (%s)", scan.time_increment,
-                    ranges.time_increment != 0.0 ? "the bag's time_increment" : "scan/sweep_time");
-      run.beam_times = scan.time_increment != 0.0 ? text : "not known (time_increment and scan/sweep_time are 0)";
-    }
+    if (run.beam_times.empty()) run.beam_times = beamTimesOf(ranges, result.scan);
     run.keyframes += update.new_keyframe;
     run.resets += update.reset;
-    if (!update.warning.empty() && ++run.warnings <= 20 && !args.quiet) {
-      std::printf("  warning at %.6f: %s\n", bag_scan.stamp, update.warning.c_str());
+    for (const std::string* warning : {&result.geometry_warning, &update.warning}) {
+      if (!warning->empty() && ++run.warnings <= 20 && !args.quiet) {
+        std::printf("  warning at %.6f: %s\n", bag_scan.stamp, warning->c_str());
+      }
     }
     if (update.published) {
       run.trajectory.push_back({bag_scan.stamp, update.pose});
@@ -534,7 +519,10 @@ std::vector<hglasm::StampedPose> inLaserFrame(const std::vector<hglasm::StampedP
 void directPairs(const Arguments& args, const hglasm::TrackerOptions& options,
                  const hglasm_odometry::BagData& data, const std::vector<hglasm::Relation>& relations,
                  double max_span, std::vector<hglasm::Pose2D>* motions, std::vector<bool>* valid) {
-  const hglasm::ScanConversionOptions conversion = conversionFor(options, data);
+  // The pipeline's conversion for this bag (mirrored for an upside-down laser).
+  hglasm::OdometryPipeline pipeline(options);
+  hglasm_odometry::setLaserMount(data, &pipeline);
+  const hglasm::ScanConversionOptions conversion = pipeline.conversion();
   const hglasm::Pose2D mount = data.has_laser_mount ? data.base_to_laser : hglasm::Pose2D();
   const auto scan_at = [&](double stamp) -> const hglasm_odometry::BagScan* {
     const auto it = std::lower_bound(
@@ -717,7 +705,7 @@ int main(int argc, char** argv) {
               : data.odometry.empty() ? "on (but none in the bag)"
                                       : "on");
 
-  const Run run = runTracker(args, options, data);
+  const Run run = runTracker(args, nodelet_options, options, data);
   printRun(run, data.scans.back().stamp - data.scans.front().stamp);
 
   // Wheel odometry at the scan stamps: the baseline the laser must beat.

@@ -3,8 +3,9 @@
 // live in one process.
 //
 // Threads: the subscription callbacks only enqueue scans (a bounded queue that drops the oldest scan and
-// counts it) and feed wheel odometry to the tracker; one worker thread per instance converts, matches and
-// publishes. The tracker is guarded by a mutex shared by the worker, the odometry callback and ~reset.
+// counts it) and feed wheel odometry to the pipeline; one worker thread per instance waits for odometry
+// (hglasm::OdometryPipeline's feeding policy), converts, matches and publishes. The pipeline is guarded
+// by a mutex shared by the worker, the odometry callback and ~reset.
 #pragma once
 
 #include <atomic>
@@ -28,7 +29,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "hglasm_odometry/core/odometry_tracker.h"
+#include "hglasm_odometry/core/odometry_pipeline.h"
 #include "hglasm_odometry/ros/conversions.h"
 #include "hglasm_odometry/ros/parameters.h"
 
@@ -60,14 +61,13 @@ class LaserOdometry {
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   void workerLoop();
-  /// Waits (bounded by options_.odometry_wait) until wheel odometry at or after `stamp` has arrived.
-  void waitForOdometry(const ros::Time& stamp);
+  /// Waits (bounded by options_.odometry_wait) until the pipeline's feeding policy lets a scan at `stamp`
+  /// be processed (wheel odometry at or after it has arrived, or none is to be expected).
+  void waitForOdometry(double stamp);
   /// Looks up base -> laser for `laser_frame` (cached); false while tf does not have it yet.
   bool ensureLaserMount(const std::string& laser_frame);
   void processScan(const sensor_msgs::LaserScan& msg);
-  void publish(const sensor_msgs::LaserScan& msg, const hglasm::TrackerUpdate& update,
-               const hglasm::Scan& scan, const hglasm::Pose2D& keyframe_before, double total_ms,
-               double table_build_ms);
+  void publish(const sensor_msgs::LaserScan& msg, const hglasm::PipelineUpdate& update, double total_ms);
   void publishPopulation(const std_msgs::Header& header, const hglasm::TrackerUpdate& update,
                          const std::vector<hglasm::Pose2D>& population);
   /// Logs `text` as a warning unless the same `key` was logged less than `period` seconds ago.
@@ -78,9 +78,10 @@ class LaserOdometry {
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
 
-  // The tracker and what is fed to it from several threads.
-  std::mutex tracker_mutex_;
-  hglasm::OdometryTracker tracker_;
+  // The pipeline, fed from several threads; odometry_cv_ (on pipeline_mutex_) signals new odometry.
+  std::mutex pipeline_mutex_;
+  std::condition_variable odometry_cv_;
+  hglasm::OdometryPipeline pipeline_;
 
   // Bounded input queue (scan callback -> worker).
   std::mutex queue_mutex_;
@@ -89,20 +90,9 @@ class LaserOdometry {
   std::uint32_t dropped_scans_ = 0;
   bool stop_ = false;
 
-  // Newest wheel-odometry stamp (odometry callback -> worker).
-  std::mutex odom_stamp_mutex_;
-  std::condition_variable odom_stamp_cv_;
-  ros::Time newest_odom_stamp_;
-
   // Worker-only state.
   bool have_mount_ = false;
   std::string mount_frame_;
-  LaserMount mount_;
-  bool have_last_geometry_ = false;
-  std::size_t last_beam_count_ = 0;
-  double last_angle_increment_ = 0.0;
-  hglasm::ScanError last_scan_error_ = hglasm::ScanError::kNone;
-  hglasm::Pose2D keyframe_pose_;  // base pose of the current keyframe (for Match.guess_pose)
   std::deque<geometry_msgs::PoseStamped> path_;
   bool warned_odom_child_frame_ = false;
 

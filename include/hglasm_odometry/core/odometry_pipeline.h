@@ -1,0 +1,115 @@
+// One laser-odometry pipeline for the live node and the offline tools: scan conversion (mirrored for an
+// upside-down laser), the scanner-geometry check, the wheel-odometry feeding policy, the tracker, and the
+// guess as the matcher saw it. Callers only add transport (ROS messages, bags), timing and output.
+#pragma once
+
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hglasm_odometry/core/odometry_tracker.h"
+#include "hglasm_odometry/core/pose2d.h"
+#include "hglasm_odometry/core/scan.h"
+
+namespace hglasm {
+
+/// The scan conversion for a laser mount: an upside-down laser's scans are mirrored. The mount decides,
+/// whatever `conversion.mirror` said before.
+ScanConversionOptions conversionForMount(ScanConversionOptions conversion, bool upside_down);
+
+/// What the pipeline did with one scan.
+struct PipelineUpdate {
+  TrackerUpdate tracker;
+  /// The converted scan in the laser frame, before de-skewing (size() valid points, invalid_count).
+  Scan scan;
+  ScanError scan_error = ScanError::kNone;
+  /// scan_error differs from the previous scan's (the first scan counts as following a valid one): log
+  /// once per change of state, not per scan.
+  bool scan_error_changed = false;
+  /// Non-empty when the scan's angle_increment changed at an unchanged beam count: the scan was made a
+  /// keyframe (a beam-count change the tracker notices itself, in tracker.warning).
+  std::string geometry_warning;
+  /// Set when a match was attempted: the predicted pose of the new laser in the keyframe's laser frame,
+  /// the guess the search was centred on.
+  std::optional<Pose2D> laser_guess;
+  double conversion_cpu_ms = 0.0;  ///< CPU time of the scan conversion (calling thread)
+};
+
+/// Not thread-safe per instance (callers with several threads guard it with one mutex); instances share
+/// nothing.
+///
+/// Wheel-odometry feeding policy (both the live node and offline replays obey it, so the tracker sees
+/// the same samples around every scan): a scan stamped t is processed once odometryReadyFor(t), i.e.
+/// once a sample stamped at or after t has been added, so the prediction at t is interpolated between
+/// the two samples around it, never extrapolated. It is not waited for when odometry is off, when none
+/// has been added yet, or when the newest sample is more than kOdometryStoppedAfter seconds older than
+/// the scan (the odometry stopped). A live node bounds the wait in wall time (odometry/wait); samples
+/// added beyond the first one at or after t change nothing, interpolation only uses the two around t.
+class OdometryPipeline {
+ public:
+  /// Seconds of scan time without a new odometry sample after which odometry counts as stopped.
+  static constexpr double kOdometryStoppedAfter = 1.0;
+
+  /// `wait_for_odometry` false: scans never wait for odometry (a live node with odometry/wait 0).
+  explicit OdometryPipeline(const TrackerOptions& options = {}, bool wait_for_odometry = true);
+
+  /// base -> laser (after mirroring) and whether the laser is upside down (its scans are then mirrored).
+  /// A non-finite mount is ignored (false).
+  bool setLaserMount(const Pose2D& base_to_laser, bool upside_down);
+
+  /// Wheel odometry: pose of the base in the wheel-odometry frame at `stamp`. Non-finite samples are
+  /// ignored (false).
+  bool addOdometry(double stamp, const Pose2D& pose);
+
+  /// Stamp of the newest odometry sample added; -infinity before the first.
+  double newestOdometryStamp() const { return newest_odometry_stamp_; }
+
+  /// The feeding policy (see the class comment): true once a scan stamped `stamp` may be processed.
+  bool odometryReadyFor(double stamp) const;
+
+  /// Offline replay of recorded odometry, under the feeding policy: adds the samples [next, end) (sorted
+  /// by stamp; each with .stamp and .pose) that a live node holds when it processes a scan at `stamp`:
+  /// every sample stamped at or before it, then later ones until odometryReadyFor(stamp). Returns the
+  /// first sample not added. Adds nothing when odometry is off. Assumes no live wait timed out; and a
+  /// sample stamped exactly at `stamp` may round an ulp differently from a live buffer that already holds a
+  /// later one (OdometryBuffer extrapolates by 0 s there instead of interpolating).
+  template <typename Iterator>
+  Iterator addRecordedOdometry(Iterator next, Iterator end, double stamp) {
+    if (!tracker_.options().use_odometry) return end;
+    for (; next != end && next->stamp <= stamp; ++next) addOdometry(next->stamp, next->pose);
+    for (; next != end && !odometryReadyFor(stamp); ++next) addOdometry(next->stamp, next->pose);
+    return next;
+  }
+
+  /// Converts and processes one scan taken at `stamp` (seconds). If `population` is given, it receives
+  /// the GA's final population as base poses in the odometry frame.
+  PipelineUpdate processScan(double stamp, const RangeScan& ranges,
+                             std::vector<Pose2D>* population = nullptr);
+
+  /// Restarts the estimate from the identity pose at the next scan. Kept: the odometry history, the
+  /// laser mount and what the previous scans looked like (geometry, error state).
+  void reset();
+
+  const TrackerOptions& options() const { return tracker_.options(); }
+  const ScanConversionOptions& conversion() const { return conversion_; }
+  const Pose2D& pose() const { return tracker_.pose(); }
+
+ private:
+  /// Requests a keyframe when angle_increment changed at an unchanged beam count (returns the warning).
+  std::string checkGeometry(const RangeScan& ranges);
+
+  OdometryTracker tracker_;
+  bool wait_for_odometry_;
+  ScanConversionOptions conversion_;
+  Pose2D base_to_laser_;
+  double newest_odometry_stamp_ = -std::numeric_limits<double>::infinity();
+
+  bool have_geometry_ = false;
+  std::size_t beam_count_ = 0;
+  double angle_increment_ = 0.0;
+  ScanError scan_error_ = ScanError::kNone;
+  Pose2D keyframe_pose_;  // base pose of the tracker's current keyframe, for the guess
+};
+
+}  // namespace hglasm

@@ -1,0 +1,193 @@
+// The pipeline shared by the live node and the offline tools: the wheel-odometry feeding policy, the replay
+// of recorded odometry, the scanner-geometry check, the scan-error state, mirroring of an upside-down
+// laser and the guess as the matcher saw it.
+#include "hglasm_odometry/core/odometry_pipeline.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "test_expect.h"
+#include "test_util.h"
+
+namespace {
+
+using hglasm::OdometryPipeline;
+using hglasm::PipelineUpdate;
+using hglasm::Pose2D;
+using hglasm::TrackerOptions;
+
+struct Sample {
+  double stamp;
+  Pose2D pose;
+};
+
+/// Straight along +x at 0.5 m/s from the origin.
+Pose2D straightAt(double t) { return hglasm_test::rawPose(0.5 * t, 0.0, 0.0); }
+
+/// Ranges of a laser at `laser_pose` (world frame); `upside_down`: seen from above its beams turn the other
+/// way, so it is simulated with negated angles and reports the usual ones.
+hglasm::RangeScan rangesAt(const Pose2D& laser_pose, bool upside_down,
+                           const hglasm_test::LaserSpec& spec = hglasm_test::halfCircleLaser()) {
+  hglasm_test::LaserSpec seen = spec;
+  if (upside_down) {
+    seen.angle_min = -spec.angle_min;
+    seen.angle_increment = -spec.angle_increment;
+  }
+  hglasm::RangeScan ranges = hglasm_test::simulateRanges(hglasm_test::room(), laser_pose, seen);
+  ranges.angle_min = spec.angle_min;
+  ranges.angle_increment = spec.angle_increment;
+  return ranges;
+}
+
+TEST(OdometryPipeline, WaitsForOdometryAtOrAfterTheScan) {
+  OdometryPipeline pipeline;
+  EXPECT_TRUE(pipeline.odometryReadyFor(1.0)) << "no odometry yet: nothing to wait for";
+  EXPECT_EQ(pipeline.newestOdometryStamp(), -std::numeric_limits<double>::infinity());
+  ASSERT_TRUE(pipeline.addOdometry(0.9, Pose2D()));
+  EXPECT_FALSE(pipeline.odometryReadyFor(1.0)) << "the sample after the scan is still to come";
+  ASSERT_TRUE(pipeline.addOdometry(1.0, Pose2D()));
+  EXPECT_TRUE(pipeline.odometryReadyFor(1.0)) << "a sample at the scan's stamp";
+  EXPECT_FALSE(pipeline.odometryReadyFor(1.05));
+  EXPECT_TRUE(pipeline.odometryReadyFor(1.0 + OdometryPipeline::kOdometryStoppedAfter + 0.01))
+      << "odometry that stopped is not waited for";
+  EXPECT_FALSE(pipeline.addOdometry(std::nan(""), Pose2D()));
+  EXPECT_FALSE(pipeline.addOdometry(2.0, Pose2D(std::nan(""), 0.0, 0.0)));
+  EXPECT_EQ(pipeline.newestOdometryStamp(), 1.0) << "rejected samples do not count";
+  ASSERT_TRUE(pipeline.addOdometry(0.5, Pose2D()));
+  EXPECT_EQ(pipeline.newestOdometryStamp(), 1.0) << "a late, older sample does not move the newest stamp";
+}
+
+TEST(OdometryPipeline, NeverWaitsWhenOdometryIsOffOrWaitingDisabled) {
+  TrackerOptions no_odometry;
+  no_odometry.use_odometry = false;
+  OdometryPipeline off(no_odometry);
+  off.addOdometry(0.9, Pose2D());
+  EXPECT_TRUE(off.odometryReadyFor(1.0));
+  OdometryPipeline no_wait(TrackerOptions(), false);
+  no_wait.addOdometry(0.9, Pose2D());
+  EXPECT_TRUE(no_wait.odometryReadyFor(1.0));
+}
+
+TEST(OdometryPipeline, ReplayAddsWhatTheLiveNodeHoldsAfterItsWait) {
+  const std::vector<Sample> samples = {{0.8, Pose2D()}, {0.9, Pose2D()}, {1.0, Pose2D()},
+                                       {1.1, Pose2D()}, {1.2, Pose2D()}, {3.5, Pose2D()}};
+  OdometryPipeline pipeline;
+  auto next = pipeline.addRecordedOdometry(samples.begin(), samples.end(), 0.95);
+  EXPECT_EQ(next - samples.begin(), 3) << "everything up to the first sample at or after the scan";
+  EXPECT_EQ(pipeline.newestOdometryStamp(), 1.0);
+  next = pipeline.addRecordedOdometry(next, samples.end(), 1.0);
+  EXPECT_EQ(next - samples.begin(), 3) << "a sample at the scan's stamp is enough";
+  next = pipeline.addRecordedOdometry(next, samples.end(), 1.15);
+  EXPECT_EQ(next - samples.begin(), 5);
+  // 1.2 s to 3.5 s: the odometry stopped for longer than kOdometryStoppedAfter; live, the sample after the
+  // gap has not arrived when the scan is processed.
+  next = pipeline.addRecordedOdometry(next, samples.end(), 2.5);
+  EXPECT_EQ(next - samples.begin(), 5);
+  EXPECT_TRUE(pipeline.odometryReadyFor(2.5));
+
+  TrackerOptions no_odometry;
+  no_odometry.use_odometry = false;
+  OdometryPipeline off(no_odometry);
+  EXPECT_EQ(off.addRecordedOdometry(samples.begin(), samples.end(), 1.0), samples.end());
+  EXPECT_EQ(off.newestOdometryStamp(), -std::numeric_limits<double>::infinity()) << "nothing added";
+}
+
+TEST(OdometryPipeline, AngleIncrementChangeAtTheSameBeamCountMakesOneKeyframeAndOneWarning) {
+  TrackerOptions options;
+  options.use_odometry = false;
+  OdometryPipeline pipeline(options);
+  const hglasm_test::LaserSpec narrow = hglasm_test::laserSpec(hglasm_test::deg(170.0), 361);
+  const hglasm_test::LaserSpec wide = hglasm_test::laserSpec(hglasm_test::deg(180.0), 361);
+  double t = 0.0;
+  const auto step = [&](const hglasm_test::LaserSpec& spec) {
+    t += 0.1;
+    return pipeline.processScan(t, rangesAt(straightAt(t), false, spec));
+  };
+  step(narrow);
+  const PipelineUpdate same = step(narrow);
+  EXPECT_TRUE(same.geometry_warning.empty());
+  EXPECT_FALSE(same.tracker.new_keyframe) << "5 cm from the keyframe";
+  const PipelineUpdate changed = step(wide);
+  EXPECT_NE(changed.geometry_warning.find("angle_increment"), std::string::npos) << changed.geometry_warning;
+  EXPECT_TRUE(changed.tracker.new_keyframe);
+  const PipelineUpdate after = step(wide);
+  EXPECT_TRUE(after.geometry_warning.empty()) << "one warning per change";
+  EXPECT_FALSE(after.tracker.new_keyframe);
+}
+
+TEST(OdometryPipeline, ScanErrorChangesAreReportedOnce) {
+  OdometryPipeline pipeline;
+  const hglasm::RangeScan good = rangesAt(Pose2D(), false);
+  hglasm::RangeScan nan_increment = good;
+  nan_increment.angle_increment = std::nan("");
+  const hglasm::RangeScan& broken = nan_increment;
+  std::vector<bool> changed;
+  double t = 0.0;
+  for (const hglasm::RangeScan* ranges : {&good, &broken, &broken, &good, &good}) {
+    const PipelineUpdate update = pipeline.processScan(t += 0.1, *ranges);
+    EXPECT_EQ(update.scan_error != hglasm::ScanError::kNone, ranges == &broken);
+    changed.push_back(update.scan_error_changed);
+  }
+  EXPECT_EQ(changed, std::vector<bool>({false, true, false, true, false}));
+}
+
+/// An upside-down laser mounted off-centre and turned: tracked only if the pipeline mirrors its scans, and
+/// the guess it reports is the laser's predicted pose in the keyframe's laser frame (next to the match).
+TEST(OdometryPipeline, MirrorsAnUpsideDownLaserAndReportsTheGuessInTheLaserFrame) {
+  const Pose2D mount(0.3, 0.1, 0.4);
+  OdometryPipeline pipeline;
+  EXPECT_FALSE(pipeline.setLaserMount(Pose2D(std::nan(""), 0.0, 0.0), true));
+  EXPECT_FALSE(pipeline.conversion().mirror) << "a rejected mount changes nothing";
+  ASSERT_TRUE(pipeline.setLaserMount(mount, true));
+  EXPECT_TRUE(pipeline.conversion().mirror);
+  int guesses = 0;
+  PipelineUpdate update;
+  std::vector<Sample> odometry;  // perfect wheel odometry at 50 Hz
+  for (int k = 0; k <= 110; ++k) odometry.push_back({0.02 * k, straightAt(0.02 * k)});
+  auto next_odometry = odometry.begin();
+  for (int i = 0; i <= 20; ++i) {
+    const double t = 0.1 * i;
+    next_odometry = pipeline.addRecordedOdometry(next_odometry, odometry.end(), t);
+    const Pose2D laser = hglasm_test::composeByHand(straightAt(t), mount);
+    update = pipeline.processScan(t, rangesAt(laser, true));
+    ASSERT_TRUE(update.tracker.published);
+    EXPECT_EQ(update.laser_guess.has_value(), update.tracker.matched);
+    if (!update.laser_guess) continue;
+    ++guesses;
+    // Perfect odometry: the guess is where the match lands (a wrong frame would be 0.1 m / 0.4 rad off).
+    hglasm_test::expectPoseNear(*update.laser_guess, update.tracker.match.pose, 0.01, 0.005,
+                                "guess vs match at " + std::to_string(t));
+  }
+  EXPECT_EQ(guesses, 20);
+  hglasm_test::expectPoseNear(update.tracker.pose, straightAt(2.0), 0.02, 0.01, "final pose");
+}
+
+TEST(OdometryPipeline, ResetRestartsAtTheOriginAndKeepsTheMount) {
+  TrackerOptions options;
+  options.use_odometry = false;
+  OdometryPipeline pipeline(options);
+  const Pose2D mount(0.3, 0.1, 0.4);
+  pipeline.setLaserMount(mount, false);
+  for (int i = 0; i <= 5; ++i) {
+    const double t = 0.1 * i;
+    pipeline.processScan(t, rangesAt(hglasm_test::composeByHand(straightAt(t), mount), false));
+  }
+  EXPECT_GT(pipeline.pose().x, 0.2);
+  pipeline.reset();
+  const PipelineUpdate first =
+      pipeline.processScan(0.6, rangesAt(hglasm_test::composeByHand(straightAt(0.6), mount), false));
+  EXPECT_TRUE(first.tracker.reset);
+  EXPECT_EQ(first.tracker.pose.x, 0.0);
+  const PipelineUpdate second =
+      pipeline.processScan(0.7, rangesAt(hglasm_test::composeByHand(straightAt(0.7), mount), false));
+  ASSERT_TRUE(second.laser_guess.has_value());
+  // From the new keyframe (the origin): 5 cm ahead, seen from the mounted laser.
+  hglasm_test::expectPoseNear(second.tracker.pose, Pose2D(0.05, 0.0, 0.0), 0.01, 0.005, "after reset");
+  hglasm_test::expectPoseNear(second.tracker.match.pose, mount.inverse() * Pose2D(0.05, 0.0, 0.0) * mount,
+                              0.01, 0.005, "match after reset");
+}
+
+}  // namespace
