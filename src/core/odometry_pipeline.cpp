@@ -43,14 +43,14 @@ bool OdometryPipeline::addOdometry(double stamp, const Pose2D& pose) {
   if (!std::isfinite(stamp) || !pose.isFinite()) return false;
   tracker_.addOdometry(stamp, pose);
   if (stamp > newest_odometry_stamp_) newest_odometry_stamp_ = stamp;
+  odometry_stalled_ = false;
   return true;
 }
 
 bool OdometryPipeline::odometryReadyFor(double stamp) const {
   if (!tracker_.options().use_odometry || !wait_for_odometry_) return true;
   if (!std::isfinite(newest_odometry_stamp_)) return true;  // none yet: nothing to wait for
-  const bool stopped = stamp - newest_odometry_stamp_ > kOdometryStoppedAfter;
-  return stopped || newest_odometry_stamp_ >= stamp;
+  return odometry_stalled_ || newest_odometry_stamp_ >= stamp;
 }
 
 std::string OdometryPipeline::checkGeometry(const RangeScan& ranges) {

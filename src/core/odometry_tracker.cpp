@@ -536,6 +536,13 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
     estimate = integratePrediction(prediction);
   }
   const Pose2D new_pose = fromMap(estimate.laser_in_map);
+  // What the models leave out (timing, the scans' distortion, the surfaces' own errors) grows with time:
+  // measured against the relations of the Freiburg logs.
+  const double dt = std::max(0.0, stamp - last_stamp_);
+  estimate.increment_covariance.diagonal() +=
+      dt * Eigen::Vector3d(options_.unexplained_xy * options_.unexplained_xy,
+                           options_.unexplained_xy * options_.unexplained_xy,
+                           options_.unexplained_theta * options_.unexplained_theta);
   pose_covariance_ =
       composeClamped(pose_, pose_covariance_, relativePose(pose_, new_pose), estimate.increment_covariance);
   map_covariance_ = estimate.map_covariance;

@@ -173,11 +173,14 @@ void LaserOdometry::odomCallback(const nav_msgs::OdometryConstPtr& msg) {
 
 void LaserOdometry::waitForOdometry(double stamp) {
   std::unique_lock<std::mutex> lock(pipeline_mutex_);
-  odometry_cv_.wait_for(lock, std::chrono::duration<double>(options_.odometry_wait), [this, stamp] {
-    if (pipeline_.odometryReadyFor(stamp)) return true;
-    std::lock_guard<std::mutex> queue_lock(queue_mutex_);
-    return stop_;
-  });
+  const bool ready =
+      odometry_cv_.wait_for(lock, std::chrono::duration<double>(options_.odometry_wait), [this, stamp] {
+        if (pipeline_.odometryReadyFor(stamp)) return true;
+        std::lock_guard<std::mutex> queue_lock(queue_mutex_);
+        return stop_;
+      });
+  // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
+  if (!ready) pipeline_.odometryWaitTimedOut();
 }
 
 bool LaserOdometry::resetCallback(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {

@@ -237,6 +237,8 @@ void readOptions(ParamTree& tree, LaserOdometryOptions* options) {
 
   // The search around the prediction, and leaps away from it.
   tree.boolean("fusion", &tracker.fusion);
+  tree.nonNegativeNumber("covariance/unexplained_xy", &tracker.unexplained_xy);
+  tree.nonNegativeNumber("covariance/unexplained_theta", &tracker.unexplained_theta);
   tree.positiveNumber("search/sigmas", &tracker.search_sigmas);
   tree.nonNegativeNumber("search/min_xy", &tracker.min_search_xy);
   tree.number("search/min_theta", &tracker.min_search_theta, 0.0, M_PI);

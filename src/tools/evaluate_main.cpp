@@ -292,7 +292,8 @@ bool writeTrajectory(const std::string& path, const std::vector<hglasm::StampedP
     std::fprintf(file, "%.6f %.6f %.6f %.6f", pose.stamp, pose.pose.x, pose.pose.y, pose.pose.theta);
     if (updates && i < updates->size()) {
       const Eigen::Matrix3d& c = (*updates)[i].increment_covariance;
-      std::fprintf(file, " %.6g %.6g %.6g %.6g %.6g %.6g", c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2), c(2, 2));
+      std::fprintf(file, " %.6g %.6g %.6g %.6g %.6g %.6g", c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2),
+                   c(2, 2));
     }
     std::fprintf(file, "\n");
   }
@@ -308,13 +309,15 @@ bool writeTrace(const std::string& path, const std::vector<hglasm::TrackerUpdate
                "box_x box_y box_theta population mahalanobis fitness status mbicp_iterations noise_xy "
                "noise_theta guess_x guess_y guess_theta leap_probability vx vy wz\n");
   for (const auto& u : updates) {
-    std::fprintf(file, "%.6f %.4f %.4f %.5f %s %d %d %d %d %d %d %d %.3f %.3f %.3f %d %.2f %.3f %s %d %.3g %.3g %.4f %.4f %.5f %.3g %.4f %.4f %.4f\n",
-                 u.stamp, u.pose.x, u.pose.y, u.pose.theta, hglasm::toString(u.prediction), u.matched, u.fallback,
-                 u.prediction_doubted, u.leap, u.jump_rejected, u.new_keyframe, u.map_keyframes, u.search.box.half_x,
-                 u.search.box.half_y, u.search.box.half_theta, u.search.population, u.prior_mahalanobis,
-                 u.fitness_ratio, hglasm::toString(u.match.status), u.match.iterations, u.noise_scale.xy,
-                 u.noise_scale.theta, u.guess.x, u.guess.y, u.guess.theta, u.leap_probability,
-                 u.velocity.x(), u.velocity.y(), u.velocity.z());
+    std::fprintf(file,
+                 "%.6f %.4f %.4f %.5f %s %d %d %d %d %d %d %d %.3f %.3f %.3f %d %.2f %.3f %s %d %.3g %.3g "
+                 "%.4f %.4f %.5f %.3g %.4f %.4f %.4f\n",
+                 u.stamp, u.pose.x, u.pose.y, u.pose.theta, hglasm::toString(u.prediction), u.matched,
+                 u.fallback, u.prediction_doubted, u.leap, u.jump_rejected, u.new_keyframe, u.map_keyframes,
+                 u.search.box.half_x, u.search.box.half_y, u.search.box.half_theta, u.search.population,
+                 u.prior_mahalanobis, u.fitness_ratio, hglasm::toString(u.match.status), u.match.iterations,
+                 u.noise_scale.xy, u.noise_scale.theta, u.guess.x, u.guess.y, u.guess.theta,
+                 u.leap_probability, u.velocity.x(), u.velocity.y(), u.velocity.z());
   }
   return std::fclose(file) == 0;
 }
@@ -476,15 +479,18 @@ void printRun(const Run& run, double data_seconds) {
     doubted += update.prediction_doubted;
     leaps += update.leap;
     if (update.matched) {
-      small_searches += update.search.population <= hglasm::presetOptions(hglasm::Preset::kSmall).genetic.population;
+      small_searches +=
+          update.search.population <= hglasm::presetOptions(hglasm::Preset::kSmall).genetic.population;
       map_keyframes += update.map_keyframes;
     }
   }
-  const hglasm::MotionNoiseScale noise = run.updates.empty() ? hglasm::MotionNoiseScale() : run.updates.back().noise_scale;
-  std::printf("\nfusion        prediction doubted %d times: %d leaps taken, %d rejected; %d of %d searches "
-              "small-sized, %.1f keyframes per map; wheel noise scale learned: xy %.3g, theta %.3g",
-              doubted, leaps, rejected, small_searches, run.matched, run.matched ? map_keyframes / run.matched : 0.0,
-              noise.xy, noise.theta);
+  const hglasm::MotionNoiseScale noise =
+      run.updates.empty() ? hglasm::MotionNoiseScale() : run.updates.back().noise_scale;
+  std::printf(
+      "\nfusion        prediction doubted %d times: %d leaps taken, %d rejected; %d of %d searches "
+      "small-sized, %.1f keyframes per map; wheel noise scale learned: xy %.3g, theta %.3g",
+      doubted, leaps, rejected, small_searches, run.matched, run.matched ? map_keyframes / run.matched : 0.0,
+      noise.xy, noise.theta);
 
   std::printf("\n\nms per scan                     scans   median      p99      max  mean/scan\n");
   const auto row = [scans](const char* label, const Spread& spread) {
@@ -558,7 +564,8 @@ double printWorstRelations(const std::vector<hglasm::Relation>& relations,
                            const std::vector<hglasm::StampedPose>& trajectory,
                            const std::vector<hglasm::StampedPose>& wheel_trajectory, double max_span) {
   std::vector<hglasm::RelationError> laser = hglasm::relationErrors(relations, trajectory, max_span);
-  const std::vector<hglasm::RelationError> wheel = hglasm::relationErrors(relations, wheel_trajectory, max_span);
+  const std::vector<hglasm::RelationError> wheel =
+      hglasm::relationErrors(relations, wheel_trajectory, max_span);
   std::map<std::size_t, hglasm::RelationError> wheel_by_index;
   for (const auto& error : wheel) wheel_by_index[error.index] = error;
   double worst_ratio = 0.0;
@@ -580,8 +587,8 @@ double printWorstRelations(const std::vector<hglasm::Relation>& relations,
       std::printf("-\n");
     }
   }
-  std::printf("  largest laser / (3 x wheel + 0.10 m) over relations <= %g s: %.3f (above 1: a leap)\n", max_span,
-              worst_ratio);
+  std::printf("  largest laser / (3 x wheel + 0.10 m) over relations <= %g s: %.3f (above 1: a leap)\n",
+              max_span, worst_ratio);
   return worst_ratio;
 }
 
@@ -633,10 +640,11 @@ void printRelations(const Arguments& args, const std::string& preset_name, const
   for (const auto& update : run.updates) increments.push_back(update.increment_covariance);
   const hglasm::CalibrationStats calibration =
       hglasm::evaluateCalibration(relations, run.trajectory, increments, args.short_span);
-  std::printf("  calibration %s: mean squared Mahalanobis distance %.2f (3 = honest covariances), median %.2f, "
-              "%.1f %% within the 95 %% bound (%d relations)\n",
-              short_label, calibration.mean_sq_mahalanobis, calibration.median_sq_mahalanobis,
-              100.0 * calibration.fraction_within_3dof_95, calibration.count);
+  std::printf(
+      "  calibration %s: mean squared Mahalanobis distance %.2f (3 = honest covariances), median %.2f, "
+      "%.1f %% within the 95 %% bound (%d relations)\n",
+      short_label, calibration.mean_sq_mahalanobis, calibration.median_sq_mahalanobis,
+      100.0 * calibration.fraction_within_3dof_95, calibration.count);
   const double worst_leap = printWorstRelations(relations, run.trajectory, wheel_trajectory, args.short_span);
   // One machine-readable line for scripts/evaluate_all.sh.
   const Spread total = spreadOf(run.total_ms);

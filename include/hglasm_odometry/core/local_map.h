@@ -17,7 +17,7 @@ struct LocalMapOptions {
   /// Keyframes in the map (1: match against the last keyframe only). More keyframes hold a scan's match to
   /// more of the surroundings, so each keyframe's own error adds up less (at low scan rates every scan is a
   /// keyframe); they cost association time.
-  int keyframes = 5;
+  int keyframes = 7;
   /// Metres: a keyframe this far from the newest one leaves the map (what the robot no longer sees).
   double max_distance = 20.0;
   /// Metres: a point this close to a point of an older keyframe adds nothing and is left out, so the map

@@ -33,7 +33,7 @@ class OdometryBuffer {
   };
   static constexpr double kMinVelocityBaseline = 0.05;  // seconds
   static constexpr double kMaxVelocityBaseline = 1.0;   // seconds
-  double max_age_;  // seconds kept behind the newest sample
+  double max_age_;                                      // seconds kept behind the newest sample
   std::deque<Sample> samples_;
 };
 

@@ -42,15 +42,13 @@ struct PipelineUpdate {
 /// Wheel-odometry feeding policy (both the live node and offline replays obey it, so the tracker sees
 /// the same samples around every scan): a scan stamped t is processed once odometryReadyFor(t), i.e.
 /// once a sample stamped at or after t has been added, so the prediction at t is interpolated between
-/// the two samples around it, never extrapolated. It is not waited for when odometry is off, when none
-/// has been added yet, or when the newest sample is more than kOdometryStoppedAfter seconds older than
-/// the scan (the odometry stopped). A live node bounds the wait in wall time (odometry/wait); samples
-/// added beyond the first one at or after t change nothing, interpolation only uses the two around t.
+/// the two samples around it, never extrapolated, even across a gap in the data. It is not waited for
+/// when odometry is off, when none has been added yet, or while odometry is stalled: a live node bounds
+/// each wait in wall time (odometry/wait) and reports a wait that timed out (odometryWaitTimedOut());
+/// scans then go on without waiting until the next sample arrives. Samples added beyond the first one
+/// at or after t change nothing: interpolation only uses the two around t.
 class OdometryPipeline {
  public:
-  /// Seconds of scan time without a new odometry sample after which odometry counts as stopped.
-  static constexpr double kOdometryStoppedAfter = 1.0;
-
   /// `wait_for_odometry` false: scans never wait for odometry (a live node with odometry/wait 0).
   explicit OdometryPipeline(const TrackerOptions& options = {}, bool wait_for_odometry = true);
 
@@ -67,6 +65,10 @@ class OdometryPipeline {
 
   /// The feeding policy (see the class comment): true once a scan stamped `stamp` may be processed.
   bool odometryReadyFor(double stamp) const;
+
+  /// A live wait for odometry timed out: odometry counts as stalled until the next sample arrives.
+  void odometryWaitTimedOut() { odometry_stalled_ = true; }
+  bool odometryStalled() const { return odometry_stalled_; }
 
   /// Offline replay of recorded odometry, under the feeding policy: adds the samples [next, end) (sorted
   /// by stamp; each with .stamp and .pose) that a live node holds when it processes a scan at `stamp`:
@@ -104,6 +106,7 @@ class OdometryPipeline {
   ScanConversionOptions conversion_;
   Pose2D base_to_laser_;
   double newest_odometry_stamp_ = -std::numeric_limits<double>::infinity();
+  bool odometry_stalled_ = false;
 
   bool have_geometry_ = false;
   std::size_t beam_count_ = 0;

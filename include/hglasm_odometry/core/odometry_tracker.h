@@ -60,6 +60,11 @@ struct TrackerOptions {
   double leap_probability = 1e-3;
   /// ... and that it stays wrong at the next scan once it was (wheels slip in bursts, a glitch lasts).
   double leap_persistence = 0.5;
+  /// Error the models do not explain, added to the published covariance: the standard deviation it
+  /// reaches after one second (a random walk in time). Calibrated so that the errors of the Freiburg
+  /// relations are covered (README: calibration).
+  double unexplained_xy = 0.035;      ///< m per sqrt(s)
+  double unexplained_theta = 0.0055;  ///< rad per sqrt(s)
   /// Outlier share of the scan likelihood that weighs leaps: a point far from the map costs log(outlier).
   double likelihood_outlier = 0.1;
 };

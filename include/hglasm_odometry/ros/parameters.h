@@ -46,7 +46,7 @@ struct LaserOdometryOptions {
   double tf_warn_period = 5.0;           ///< seconds between "waiting for tf" messages
   /// Wall seconds a scan may wait for wheel odometry stamped at or after it (so the prediction is
   /// interpolated, not held from an older sample). Not waited for when odometry has stopped; 0 = never.
-  double odometry_wait = 0.1;
+  double odometry_wait = 0.25;
   DiagnosticsOptions diagnostics;
 };
 
