@@ -365,11 +365,13 @@ bool Mbicp::solveStep(const Pose2D& pose, bool settled, std::size_t min_associat
     return m;
   };
   *scan_only_step = damped(a).ldlt().solve(-b);
+  // The scan's information: the same normal equations in units of the residuals' (calibrated) noise.
+  const double variance =
+      std::max(residual_sq / std::max<double>(1.0, static_cast<double>(count) - 3.0), kNoiseFloor);
+  scan_information_ = a * (informationScale(count) / variance);
   if (prior) {
-    // MAP step: the residuals in units of their (calibrated) noise, plus the prior on the pose. The pose
-    // moves by G q for an increment q applied in the reference frame.
-    const double variance =
-        std::max(residual_sq / std::max<double>(1.0, static_cast<double>(count) - 3.0), kNoiseFloor);
+    // MAP step: the scan's information plus the prior on the pose. The pose moves by G q for an increment
+    // q applied in the reference frame.
     const double weight = informationScale(count) / variance;
     a *= weight;
     b *= weight;
@@ -427,7 +429,9 @@ void Mbicp::estimateUncertainty(const PosePrior* prior, MbicpResult* result) con
   // G maps that increment to the pose's own (x, y, theta).
   const Eigen::Matrix3d to_pose = incrementToPose(result->pose);
   const Eigen::Matrix3d from_pose = to_pose.inverse();
-  result->scan_information = from_pose.transpose() * (information / variance) * from_pose;
+  // What the MAP weighed the scan with (the metric's normal equations of the last iteration): a posterior
+  // built from it below is the one the iterations converged to.
+  result->scan_information = from_pose.transpose() * scan_information_ * from_pose;
   if (prior) {
     const Eigen::Matrix3d posterior = result->scan_information + prior->information;
     result->covariance = clampEigenvalues(posterior.inverse(), kMinVariance, kMaxVariance);

@@ -296,4 +296,122 @@ TEST(Mbicp, IterationLimitIsReported) {
   EXPECT_EQ(result.status, MbicpStatus::kMaxIterations) << describe(result);
 }
 
+// ------------------------------------------------------------------ with a prior on the pose
+
+hglasm::PosePrior priorAt(const Pose2D& mean, double sigma_xy, double sigma_theta) {
+  hglasm::PosePrior prior;
+  prior.mean = mean;
+  prior.information = Eigen::Vector3d(1.0 / (sigma_xy * sigma_xy), 1.0 / (sigma_xy * sigma_xy),
+                                      1.0 / (sigma_theta * sigma_theta))
+                          .asDiagonal();
+  return prior;
+}
+
+TEST(MbicpWithPrior, InAFeaturelessCorridorThePriorDecidesTheAxisTheScanCannotSee) {
+  const auto world = hglasm_test::corridor(1.0, 200.0);
+  const auto laser = hglasm_test::laserSpec(deg(270.0), 541, false, 8.0);
+  const Pose2D truth(0.40, 0.02, 0.01);
+  Mbicp mbicp;
+  mbicp.setReference(hglasm_test::simulateScan(world, Pose2D(), laser));
+  const Scan scan = hglasm_test::simulateScan(world, truth, laser);
+  const hglasm::PosePrior prior = priorAt(Pose2D(0.25, 0.0, 0.0), 0.05, 0.05);
+  const MbicpResult result = mbicp.match(scan, prior.mean, &prior);
+  expectSane(result);
+  EXPECT_EQ(result.status, MbicpStatus::kConverged)
+      << describe(result) << ": with a prior, degeneracy is no failure";
+  EXPECT_TRUE(result.degenerate);
+  EXPECT_NEAR(result.pose.x, 0.25, 2e-3) << "along the corridor: the prior's mean";
+  EXPECT_NEAR(result.pose.y, truth.y, 2e-3) << "across: the scan";
+  EXPECT_NEAR(hglasm_test::angleDiff(result.pose.theta, truth.theta), 0.0, deg(0.05)) << "heading: the scan";
+  // The posterior: the prior's spread along the corridor, the scan's (far smaller) across it.
+  EXPECT_NEAR(std::sqrt(result.covariance(0, 0)), 0.05, 0.005) << result.covariance;
+  EXPECT_LT(result.covariance(1, 1), 0.01 * result.covariance(0, 0)) << result.covariance;
+}
+
+TEST(MbicpWithPrior, AWellConstrainedScanOutweighsAWeakPrior) {
+  const auto world = hglasm_test::room();
+  const auto laser = hglasm_test::halfCircleLaser();
+  const Pose2D truth(0.10, -0.05, 0.03);
+  Mbicp mbicp;
+  mbicp.setReference(hglasm_test::simulateScan(world, Pose2D(), laser));
+  const hglasm::PosePrior prior = priorAt(Pose2D(0.15, 0.0, 0.05), 0.1, 0.1);
+  const MbicpResult result = mbicp.match(hglasm_test::simulateScan(world, truth, laser), prior.mean, &prior);
+  expectExact(result, truth);
+  EXPECT_FALSE(result.degenerate);
+  EXPECT_LT(hglasm_test::translationError(result.scan_only_pose, truth), kExactXy);
+}
+
+TEST(MbicpWithPrior, APosteriorIsTheInformationWeightedMeanOfScanAndPrior) {
+  // A strong prior 3 cm off: the result is where the two informations balance (to first order).
+  const auto world = hglasm_test::room();
+  const auto laser = hglasm_test::halfCircleLaser();
+  const Pose2D truth(0.10, -0.05, 0.03);
+  hglasm::MbicpOptions options;
+  options.independent_points = 5.0;  // a weak scan, so that the prior visibly pulls
+  Mbicp mbicp(options);
+  mbicp.setReference(hglasm_test::simulateScan(world, Pose2D(), laser));
+  const Scan scan = hglasm_test::simulateScan(world, truth, laser);
+  const hglasm::PosePrior prior = priorAt(Pose2D(0.13, -0.05, 0.03), 0.01, 0.01);
+  const MbicpResult result = mbicp.match(scan, truth, &prior);
+  expectSane(result);
+  const Eigen::Matrix3d& scan_information = result.scan_information;
+  const Eigen::Vector3d scan_only(truth.x, truth.y, truth.theta);
+  const Eigen::Vector3d mean(prior.mean.x, prior.mean.y, prior.mean.theta);
+  const Eigen::Vector3d expected = (scan_information + prior.information)
+                                       .ldlt()
+                                       .solve(scan_information * scan_only + prior.information * mean);
+  EXPECT_GT(result.pose.x - truth.x, 0.002) << "the prior pulls";
+  EXPECT_LT(result.pose.x - truth.x, 0.028) << "the scan pulls back";
+  EXPECT_NEAR(result.pose.x, expected.x(), 1e-3) << describe(result);
+  EXPECT_NEAR(result.pose.y, expected.y(), 1e-3) << describe(result);
+  EXPECT_NEAR(result.pose.theta, expected.z(), 1e-4) << describe(result);
+  // Where the scan alone would be: the truth.
+  EXPECT_LT(hglasm_test::translationError(result.scan_only_pose, truth), 2e-3);
+  // And the posterior covariance is the inverse of the summed information.
+  const Eigen::Matrix3d posterior = (scan_information + prior.information).inverse();
+  EXPECT_LT((result.covariance - posterior).cwiseAbs().maxCoeff(), 1e-3 * posterior.cwiseAbs().maxCoeff());
+}
+
+TEST(MbicpWithPrior, IndependentPointsDivideTheInformation) {
+  // n associations count as at most independent_points: the covariance grows by n / independent_points.
+  const auto world = hglasm_test::room();
+  const auto laser = hglasm_test::halfCircleLaser();
+  const Pose2D truth(0.05, 0.02, 0.01);
+  const MbicpResult all = matchInRoom(world, laser, Pose2D(), truth, Pose2D());
+  hglasm::MbicpOptions options;
+  options.independent_points = 20.0;
+  const MbicpResult twenty = matchInRoom(world, laser, Pose2D(), truth, Pose2D(), options);
+  ASSERT_GT(all.associations, 200);
+  EXPECT_LT(hglasm_test::translationError(all.pose, twenty.pose), 1e-9) << "the estimate does not change";
+  const double ratio = twenty.covariance(0, 0) / all.covariance(0, 0);
+  EXPECT_GT(ratio, 0.9 * all.associations / 20.0);
+  EXPECT_LT(ratio, 1.1 * all.associations / 20.0);
+  options.independent_points = 1e6;  // more than there are points: every point counts once
+  const MbicpResult capped = matchInRoom(world, laser, Pose2D(), truth, Pose2D(), options);
+  EXPECT_NEAR(capped.covariance(0, 0), all.covariance(0, 0), 1e-12);
+}
+
+TEST(MbicpWithPrior, ANonFinitePriorIsIgnored) {
+  const auto world = hglasm_test::room();
+  const auto laser = hglasm_test::halfCircleLaser();
+  const Pose2D truth(0.05, 0.02, 0.01);
+  Mbicp mbicp;
+  mbicp.setReference(hglasm_test::simulateScan(world, Pose2D(), laser));
+  hglasm::PosePrior prior = priorAt(Pose2D(std::nan(""), 0.0, 0.0), 0.01, 0.01);
+  expectExact(mbicp.match(hglasm_test::simulateScan(world, truth, laser), Pose2D(), &prior), truth);
+}
+
+TEST(Mbicp, SeveralScansAsOneReference) {
+  // The reference made of two half-scans taken from two poses: a scan from a third pose matches it.
+  const auto world = hglasm_test::room();
+  const auto laser = hglasm_test::halfCircleLaser();
+  const Pose2D first(0.0, 0.0, 0.0), second(0.3, 0.1, 0.2), truth(0.15, 0.05, 0.1);
+  hglasm::ReferencePoints reference;
+  reference.append(hglasm_test::simulateScan(world, first, laser).points, Pose2D());
+  reference.append(hglasm_test::simulateScan(world, second, laser).points, second);
+  Mbicp mbicp;
+  mbicp.setReference(reference);
+  expectExact(mbicp.match(hglasm_test::simulateScan(world, truth, laser), Pose2D()), truth);
+}
+
 }  // namespace

@@ -118,7 +118,8 @@ class Mbicp {
   std::vector<double> sorted_bearing_;        // bearings of reference points, ascending
   std::vector<int> sorted_index_;             // their indices into ref_points_
   std::vector<Association> associations_;     // scratch
-  std::vector<Eigen::Vector2d> moved_;        // scratch
+  Eigen::Matrix3d scan_information_ = Eigen::Matrix3d::Zero();  // of the last step, increment coordinates
+  std::vector<Eigen::Vector2d> moved_;                          // scratch
 };
 
 }  // namespace hglasm
