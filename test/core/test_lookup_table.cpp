@@ -53,7 +53,7 @@ TEST(LookupTable, EmptyBeforeBuildAndForEmptyReference) {
   EXPECT_TRUE(table.empty());
   EXPECT_EQ(table.valueAt(Eigen::Vector2d::Zero()), 0);
   EXPECT_EQ(table.fitness(Points{Eigen::Vector2d::Zero()}, hglasm::Pose2D()), 0u);
-  table.build({});
+  table.build(std::vector<Eigen::Vector2d>{});
   EXPECT_TRUE(table.empty());
   EXPECT_EQ(table.tileCount(), 0u);
   EXPECT_EQ(table.fitness(Points{Eigen::Vector2d::Zero()}, hglasm::Pose2D()), 0u);
@@ -281,7 +281,7 @@ TEST(LookupTable, RebuildReplacesTheOldReference) {
   table.build({{10.0, -3.0}});
   EXPECT_EQ(table.valueAt({0.0, 0.0}), 0);
   EXPECT_EQ(table.valueAt({10.0, -3.0}), 255);
-  table.build({});
+  table.build(std::vector<Eigen::Vector2d>{});
   EXPECT_TRUE(table.empty());
   EXPECT_EQ(table.valueAt({10.0, -3.0}), 0);
 }

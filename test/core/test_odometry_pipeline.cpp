@@ -51,13 +51,19 @@ TEST(OdometryPipeline, WaitsForOdometryAtOrAfterTheScan) {
   ASSERT_TRUE(pipeline.addOdometry(1.0, Pose2D()));
   EXPECT_TRUE(pipeline.odometryReadyFor(1.0)) << "a sample at the scan's stamp";
   EXPECT_FALSE(pipeline.odometryReadyFor(1.05));
-  EXPECT_TRUE(pipeline.odometryReadyFor(1.0 + OdometryPipeline::kOdometryStoppedAfter + 0.01))
-      << "odometry that stopped is not waited for";
+  EXPECT_FALSE(pipeline.odometryReadyFor(5.0)) << "old odometry is waited for: a gap in the data, not a stop";
+  pipeline.odometryWaitTimedOut();
+  EXPECT_TRUE(pipeline.odometryStalled());
+  EXPECT_TRUE(pipeline.odometryReadyFor(5.0)) << "after a wait timed out, odometry counts as stalled";
   EXPECT_FALSE(pipeline.addOdometry(std::nan(""), Pose2D()));
   EXPECT_FALSE(pipeline.addOdometry(2.0, Pose2D(std::nan(""), 0.0, 0.0)));
   EXPECT_EQ(pipeline.newestOdometryStamp(), 1.0) << "rejected samples do not count";
+  EXPECT_TRUE(pipeline.odometryStalled()) << "rejected samples do not revive it either";
+  ASSERT_TRUE(pipeline.addOdometry(1.1, Pose2D()));
+  EXPECT_FALSE(pipeline.odometryStalled()) << "a new sample: it moves again";
+  EXPECT_FALSE(pipeline.odometryReadyFor(5.0));
   ASSERT_TRUE(pipeline.addOdometry(0.5, Pose2D()));
-  EXPECT_EQ(pipeline.newestOdometryStamp(), 1.0) << "a late, older sample does not move the newest stamp";
+  EXPECT_EQ(pipeline.newestOdometryStamp(), 1.1) << "a late, older sample does not move the newest stamp";
 }
 
 TEST(OdometryPipeline, NeverWaitsWhenOdometryIsOffOrWaitingDisabled) {
@@ -82,10 +88,10 @@ TEST(OdometryPipeline, ReplayAddsWhatTheLiveNodeHoldsAfterItsWait) {
   EXPECT_EQ(next - samples.begin(), 3) << "a sample at the scan's stamp is enough";
   next = pipeline.addRecordedOdometry(next, samples.end(), 1.15);
   EXPECT_EQ(next - samples.begin(), 5);
-  // 1.2 s to 3.5 s: the odometry stopped for longer than kOdometryStoppedAfter; live, the sample after the
-  // gap has not arrived when the scan is processed.
+  // 1.2 s to 3.5 s: a gap in the data. The replay adds the sample after it, as a live node that receives it
+  // within its wait does: the scan's prediction is interpolated across the gap.
   next = pipeline.addRecordedOdometry(next, samples.end(), 2.5);
-  EXPECT_EQ(next - samples.begin(), 5);
+  EXPECT_EQ(next - samples.begin(), 6);
   EXPECT_TRUE(pipeline.odometryReadyFor(2.5));
 
   TrackerOptions no_odometry;

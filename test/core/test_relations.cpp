@@ -2,10 +2,12 @@
 #include "hglasm_odometry/core/relations.h"
 
 #include <gtest/gtest.h>
+#include <Eigen/Cholesky>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -222,6 +224,69 @@ TEST(Relations, PairwiseMotionsUseTheSameMetric) {
   const RelationStats all = evaluateRelativeMotions(relations, estimated, valid, 0.0);
   EXPECT_EQ(all.count, 2);
   EXPECT_EQ(all.missing, 1);
+}
+
+/// A trajectory whose every step is the true step (0.1 m forward, turning 0.02 rad) plus Gaussian noise of
+/// the given covariance, and relations of the true motion over 4 steps.
+struct NoisyRun {
+  std::vector<StampedPose> trajectory;
+  std::vector<Relation> relations;
+};
+
+NoisyRun noisyRun(const Eigen::Matrix3d& step_covariance, int steps, std::uint64_t seed) {
+  NoisyRun run;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal;
+  const Eigen::Matrix3d root = step_covariance.llt().matrixL();
+  const Pose2D true_step(0.1, 0.0, 0.02);
+  Pose2D estimate;
+  run.trajectory.push_back({0.0, estimate});
+  for (int i = 1; i <= steps; ++i) {
+    const Eigen::Vector3d noise = root * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    estimate =
+        estimate * Pose2D(true_step.x + noise.x(), true_step.y + noise.y(), true_step.theta + noise.z());
+    run.trajectory.push_back({0.1 * i, estimate});
+  }
+  const Pose2D four_steps = true_step * true_step * true_step * true_step;
+  for (int i = 0; i + 4 <= steps; i += 4) run.relations.push_back({0.1 * i, 0.1 * (i + 4), four_steps});
+  return run;
+}
+
+TEST(Calibration, HonestCovariancesGiveAMeanSquaredMahalanobisDistanceOfThree) {
+  const Eigen::Matrix3d step = Eigen::Vector3d(1e-4, 4e-5, 1e-5).asDiagonal();
+  const NoisyRun run = noisyRun(step, 8000, 3);
+  const std::vector<Eigen::Matrix3d> honest(run.trajectory.size(), step);
+  const CalibrationStats stats = evaluateCalibration(run.relations, run.trajectory, honest, 10.0);
+  EXPECT_EQ(stats.count, 2000);
+  EXPECT_NEAR(stats.mean_sq_mahalanobis, 3.0, 0.2);
+  EXPECT_NEAR(stats.median_sq_mahalanobis, 2.37, 0.2);  // the chi-square median for 3 degrees of freedom
+  EXPECT_NEAR(stats.fraction_within_3dof_95, 0.95, 0.015);
+  // Covariances 4 times too large read as a quarter; 4 times too small as four times.
+  const std::vector<Eigen::Matrix3d> cautious(run.trajectory.size(), 4.0 * step);
+  EXPECT_NEAR(evaluateCalibration(run.relations, run.trajectory, cautious, 10.0).mean_sq_mahalanobis, 0.75,
+              0.06);
+  const std::vector<Eigen::Matrix3d> confident(run.trajectory.size(), 0.25 * step);
+  EXPECT_NEAR(evaluateCalibration(run.relations, run.trajectory, confident, 10.0).mean_sq_mahalanobis, 12.0,
+              0.8);
+}
+
+TEST(Calibration, MismatchedInputsGiveNoStatistics) {
+  const NoisyRun run = noisyRun(Eigen::Matrix3d::Identity() * 1e-4, 40, 4);
+  const std::vector<Eigen::Matrix3d> too_few(3, Eigen::Matrix3d::Identity());
+  EXPECT_EQ(evaluateCalibration(run.relations, run.trajectory, too_few, 10.0).count, 0);
+}
+
+TEST(Relations, PerRelationErrorsInTheOrderOfTheRelations) {
+  const std::vector<StampedPose> trajectory = {
+      {0.0, Pose2D()}, {1.0, Pose2D(1.0, 0.0, 0.0)}, {2.0, Pose2D(2.0, 0.1, 0.0)}};
+  const std::vector<Relation> relations = {
+      {0.0, 1.0, Pose2D(1.0, 0.0, 0.0)}, {1.0, 2.0, Pose2D(1.0, 0.0, 0.0)}, {0.0, 25.0, Pose2D()}};
+  const std::vector<RelationError> errors = relationErrors(relations, trajectory, 10.0);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].index, 0u);
+  EXPECT_NEAR(errors[0].trans, 0.0, 1e-12);
+  EXPECT_EQ(errors[1].index, 1u);
+  EXPECT_NEAR(errors[1].trans, 0.1, 1e-12);
 }
 
 }  // namespace

@@ -90,6 +90,8 @@ class Robot {
     jump_time_ = jump_time;
     jump_ = jump;
   }
+  /// The wheels report this path instead of the true one (their own errors).
+  void setOdometryPath(Path path) { odometry_path_ = std::move(path); }
   /// Odometry samples are handed to the tracker only `delay` seconds after their stamp.
   void setOdometryDelay(double delay) { odometry_delay_ = delay; }
 
@@ -109,7 +111,7 @@ class Robot {
     if (odometry_) {
       while (odometry_time_ + 0.02 <= t - odometry_delay_ + 1e-9) {
         odometry_time_ += 0.02;
-        Pose2D pose = path_(odometry_time_);
+        Pose2D pose = odometry_path_ ? odometry_path_(odometry_time_) : path_(odometry_time_);
         if (odometry_time_ >= jump_time_) pose = hglasm_test::composeByHand(jump_, pose);
         tracker_.addOdometry(odometry_time_ + stamp_offset_, pose);
       }
@@ -131,6 +133,7 @@ class Robot {
  private:
   OdometryTracker tracker_;
   Path path_;
+  Path odometry_path_;  // empty: the wheels report the truth
   hglasm_test::World world_;
   LaserSpec laser_;
   bool odometry_ = false;
@@ -512,6 +515,9 @@ TEST(Robustness, FeaturelessCorridorIsUncertainAlongItAndDoesNotJump) {
   for (bool with_odometry : {true, false}) {
     SCOPED_TRACE(with_odometry ? "with odometry" : "without odometry");
     TrackerOptions options = with_odometry ? TrackerOptions() : withoutOdometry();
+    // The calibrated floor of unexplained error is the same in every direction; what is checked here is
+    // what the scan and the wheels know.
+    options.unexplained_xy = options.unexplained_theta = 0.0;
     Robot robot(options, arcPath(0.5, 0.0), laser, hglasm_test::corridor(1.0, 200.0));
     if (with_odometry) robot.enableOdometry();
     TrackerUpdate update, previous;
@@ -538,6 +544,79 @@ TEST(Robustness, FeaturelessCorridorIsUncertainAlongItAndDoesNotJump) {
       EXPECT_LT(std::abs(update.pose.x), 6.0) << describe(update);
     }
   }
+}
+
+// ------------------------------------------------------------------ fusion: the prediction as a prior
+
+TEST(Fusion, AWheelSlipTheScansContradictIsOverruledAsALeap) {
+  // From 2.03 s on the wheel odometry is 0.3 m off sideways (a slip; small enough to pass as plausible
+  // motion): the scans in the room say otherwise, and the estimate must follow them, flagged as a leap.
+  Robot robot(TrackerOptions(), circlePath);
+  robot.enableOdometry(2.03, Pose2D(0.0, 0.3, 0.0));
+  int leaps = 0;
+  for (int i = 0; i <= 50; ++i) {
+    const TrackerUpdate update = robot.step(0.1 * i);
+    if (i == 0) continue;
+    EXPECT_FALSE(update.fallback) << describe(update);
+    EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+    leaps += update.leap;
+    expectPoseNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
+  }
+  EXPECT_GE(leaps, 1) << "the step over the slip";
+  EXPECT_LE(leaps, 2) << "afterwards the wheels' increments are right again";
+}
+
+TEST(Fusion, InACorridorTheWallsGiveTheHeadingAndTheWheelsTheDistance) {
+  // Straight along a featureless corridor while the wheels believe they turn at 0.05 rad/s (17 degrees
+  // in 6 s). Fused, the scans fix heading and side offset and the wheels the distance travelled; a match
+  // that replaces the wheels cannot see the distance, fails, and integrates the drifting wheels instead.
+  const auto laser = hglasm_test::laserSpec(deg(270.0), 541, false, 8.0);
+  const auto drive = [&](bool fusion) {
+    TrackerOptions options;
+    options.fusion = fusion;
+    Robot robot(options, arcPath(0.5, 0.0), laser, hglasm_test::corridor(1.0, 200.0));
+    robot.enableOdometry();
+    robot.setOdometryPath(arcPath(0.5, 0.05));
+    TrackerUpdate update;
+    for (int i = 0; i <= 60; ++i) update = robot.step(0.1 * i);
+    return update;
+  };
+  const TrackerUpdate fused = drive(true);
+  EXPECT_NEAR(fused.pose.y, 0.0, 0.02) << describe(fused);
+  EXPECT_NEAR(fused.pose.theta, 0.0, deg(0.5)) << describe(fused);
+  EXPECT_NEAR(fused.pose.x, 3.0, 0.1) << describe(fused) << ": the wheels' distance";
+  const TrackerUpdate replaced = drive(false);
+  EXPECT_GT(std::abs(replaced.pose.theta), deg(10.0)) << describe(replaced);
+}
+
+/// Clockwise circle of radius 1.5 m at 0.5 m/s, as wheels that over-report the turn rate by `factor` see it.
+Path miscalibratedCircle(double factor) {
+  return [factor](double t) {
+    const double radius = 1.5 / factor, rate = 0.5 / radius;
+    return hglasm_test::rawPose(radius * std::sin(rate * t), -radius + radius * std::cos(rate * t),
+                                hglasm_test::angleDiff(-rate * t, 0.0));
+  };
+}
+
+TEST(Fusion, TheWheelsNoiseIsLearnedFromTheScans) {
+  // Exact wheels teach a small heading-noise scale; wheels that over-report turning by half a large one,
+  // and the estimate follows the scans either way.
+  const auto drive = [](double factor) {
+    Robot robot(TrackerOptions(), circlePath);
+    robot.enableOdometry();
+    robot.setOdometryPath(miscalibratedCircle(factor));
+    TrackerUpdate update;
+    for (int i = 0; i <= 300; ++i) {
+      update = robot.step(0.1 * i);
+      expectPoseNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
+    }
+    return update.noise_scale;
+  };
+  const hglasm::MotionNoiseScale exact = drive(1.0);
+  const hglasm::MotionNoiseScale bad = drive(1.5);
+  EXPECT_LT(exact.theta, 0.1);
+  EXPECT_GT(bad.theta, 1.0);
+  EXPECT_GT(bad.theta, 20.0 * exact.theta);
 }
 
 }  // namespace
