@@ -160,6 +160,58 @@ TEST(Parameters, OutOfRangeValuesNameTheParameter) {
   EXPECT_NE(loadError(params({{"scan/deskew", 1.5}})).find("~scan/deskew"), std::string::npos);
 }
 
+TEST(Parameters, FusionLocalMapAndNoiseParametersAreValidated) {
+  EXPECT_NE(
+      loadError(params({{"leap/probability", 0.0}})).find("~leap/probability must be a number in [0, 0.5]"),
+      std::string::npos);
+  EXPECT_NE(loadError(params({{"leap/persistence", 1.5}})).find("~leap/persistence"), std::string::npos);
+  EXPECT_NE(
+      loadError(params({{"leap/max_mahalanobis", 0.0}})).find("~leap/max_mahalanobis must be a positive"),
+      std::string::npos);
+  EXPECT_NE(
+      loadError(params({{"local_map/keyframes", 0}})).find("~local_map/keyframes must be a positive integer"),
+      std::string::npos);
+  EXPECT_NE(loadError(params({{"local_map/resolution", -0.1}})).find("~local_map/resolution"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"search/sigmas", -1.0}})).find("~search/sigmas"), std::string::npos);
+  EXPECT_NE(loadError(params({{"odometry/noise/xy_per_metre", -0.1}})).find("~odometry/noise/xy_per_metre"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"odometry/noise/min_scale", 2.0}, {"odometry/noise/max_scale", 1.0}}))
+                .find("~odometry/noise/max_scale must be at least ~odometry/noise/min_scale"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"covariance/unexplained_xy", "big"}})).find("~covariance/unexplained_xy"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"fusion", 1}})).find("~fusion must be true or false"), std::string::npos);
+  EXPECT_NE(loadError(params({{"mbicp/independent_points", -5.0}})).find("~mbicp/independent_points"),
+            std::string::npos);
+}
+
+TEST(Parameters, FusionLocalMapAndNoiseParametersAreRead) {
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(params({{"fusion", false},
+                                  {"local_map/keyframes", 3},
+                                  {"local_map/resolution", 0.05},
+                                  {"leap/probability", 0.01},
+                                  {"odometry/noise/learn", false},
+                                  {"odometry/noise/theta_per_radian", 0.2},
+                                  {"constant_velocity/xy", 2.0},
+                                  {"covariance/unexplained_theta", 0.01},
+                                  {"search/min_xy", 0.2}}),
+                          &options, &error))
+      << error;
+  const hglasm::TrackerOptions& t = options.tracker;
+  EXPECT_FALSE(t.fusion);
+  EXPECT_EQ(t.local_map.keyframes, 3);
+  EXPECT_EQ(t.local_map.resolution, 0.05);
+  EXPECT_EQ(t.leap_probability, 0.01);
+  EXPECT_FALSE(t.motion.learn);
+  EXPECT_EQ(t.motion.theta_per_radian, 0.2);
+  EXPECT_EQ(t.motion.constant_velocity_xy, 2.0);
+  EXPECT_EQ(t.unexplained_theta, 0.01);
+  EXPECT_EQ(t.min_search_xy, 0.2);
+}
+
 TEST(Parameters, NonFiniteNumbersAreRejectedExceptAnInfiniteMaxRange) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
