@@ -15,7 +15,8 @@
 //   max_short_trans_error  metres: the same over the relations spanning at most 10 s
 //   max_short_rot_error_deg  degrees: the same over the relations spanning at most 10 s
 //   max_fallback_ratio     bound on the fraction of matches that fell back to the prediction
-//   min_deskewed_ratio     the fraction of matches that must have been de-skewed (default 0: not checked)
+//   min_deskewed_ratio / max_deskewed_ratio  bounds on the fraction of matches that were de-skewed
+//                          (defaults 0 and 1)
 //   timeout                wall seconds for the whole replay (default 100)
 #include <gtest/gtest.h>
 
@@ -67,6 +68,7 @@ struct Settings {
   double max_short_rot_error_deg = 1.0;
   double max_fallback_ratio = 0.1;
   double min_deskewed_ratio = 0.0;
+  double max_deskewed_ratio = 1.0;
   double timeout = 100.0;
 };
 
@@ -114,6 +116,7 @@ std::unique_ptr<Recording> record() {
   private_nh.getParam("max_short_rot_error_deg", s.max_short_rot_error_deg);
   private_nh.getParam("max_fallback_ratio", s.max_fallback_ratio);
   private_nh.getParam("min_deskewed_ratio", s.min_deskewed_ratio);
+  private_nh.getParam("max_deskewed_ratio", s.max_deskewed_ratio);
   private_nh.getParam("timeout", s.timeout);
 
   // The bag's scan stamps and wheel odometry.
@@ -308,7 +311,7 @@ TEST_F(OdometryReplay, FallbacksAreRare) {
   EXPECT_LE(ratio, r.settings.max_fallback_ratio);
 }
 
-TEST_F(OdometryReplay, ScansAreDeskewed) {
+TEST_F(OdometryReplay, ScansAreDeskewedAsConfigured) {
   const Recording& r = *recording_;
   int matched = 0, deskewed = 0;
   for (const auto& m : r.matches) {
@@ -318,6 +321,7 @@ TEST_F(OdometryReplay, ScansAreDeskewed) {
   ASSERT_GT(matched, 0);
   std::printf("[measured] %d of %d matches de-skewed\n", deskewed, matched);
   EXPECT_GE(static_cast<double>(deskewed) / matched, r.settings.min_deskewed_ratio);
+  EXPECT_LE(static_cast<double>(deskewed) / matched, r.settings.max_deskewed_ratio);
 }
 
 TEST_F(OdometryReplay, TrajectoryMatchesTheReferenceRelations) {
