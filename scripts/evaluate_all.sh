@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Runs `evaluate` on the Freiburg relations benchmark logs (intel, fr079) for every preset and prints
+# Runs `evaluate` on the Freiburg relations benchmark logs (intel, fr079, aces) for every preset and prints
 # one table: relations metric (all and <= 10 s) of the laser odometry next to the raw wheel odometry,
-# fallbacks and CPU per scan. Logs, trajectories and plots of each run go to the output directory.
+# fallbacks, CPU per scan, the covariance calibration (mean squared Mahalanobis distance of the <= 10 s
+# relations; 3 is honest) and the leap ratio (largest <= 10 s error / (3 x the wheels' + 0.10 m); above 1 is
+# a leap). Logs, trajectories, traces and plots of each run go to the output directory.
 #
 # usage: scripts/evaluate_all.sh [-e EVALUATE] [-d DATASETS] [-o OUT_DIR] [-p "small medium large"]
 #                                [-l "intel fr079"] [-- extra evaluate arguments]
@@ -10,7 +12,7 @@
 #   -d  the datasets folder (default: <package>/../shared/datasets)
 #   -o  where run logs, trajectories and plots go (default: /tmp/hglasm_evaluate_all)
 #   -p  presets (default: the top-level keys of config/presets.yaml, else "small medium large")
-#   -l  logs (default: "intel fr079")
+#   -l  logs (default: "intel fr079 aces")
 # Example: scripts/evaluate_all.sh -e /work/build/devel/lib/hglasm_odometry/evaluate -- --config /tmp/my.yaml
 set -euo pipefail
 
@@ -19,7 +21,7 @@ evaluate="${EVALUATE:-}"
 datasets="$package_dir/../shared/datasets"
 out_dir="/tmp/hglasm_evaluate_all"
 presets=""
-logs="intel fr079"
+logs="intel fr079 aces"
 
 while getopts "e:d:o:p:l:h" option; do
   case "$option" in
@@ -28,8 +30,8 @@ while getopts "e:d:o:p:l:h" option; do
     o) out_dir="$OPTARG" ;;
     p) presets="$OPTARG" ;;
     l) logs="$OPTARG" ;;
-    h) sed -n '2,14p' "$0"; exit 0 ;;
-    *) sed -n '2,14p' "$0" >&2; exit 2 ;;
+    h) sed -n '2,16p' "$0"; exit 0 ;;
+    *) sed -n '2,16p' "$0" >&2; exit 2 ;;
   esac
 done
 shift $((OPTIND - 1))
@@ -64,8 +66,9 @@ echo "runs:     $out_dir/<log>_<preset>.{log,txt,png}"
 [[ ${#extra_args[@]} -gt 0 ]] && echo "extra:    ${extra_args[*]}"
 echo
 
-header=$(printf "%-6s %-8s %6s %9s %21s | %-17s %-17s | %-17s %-17s" \
-  log preset scans fallback "CPU ms med/p99/max" "<=10s laser m/deg" "<=10s wheel" "all laser m/deg" "all wheel")
+header=$(printf "%-6s %-8s %6s %9s %21s | %-17s %-17s | %-17s %-17s | %5s %5s" \
+  log preset scans fallback "CPU ms med/p99/max" "<=10s laser m/deg" "<=10s wheel" "all laser m/deg" "all wheel" \
+  calib leap)
 echo "$header"
 printf '%*s\n' "${#header}" '' | tr ' ' '-'
 
@@ -81,17 +84,18 @@ for log in $logs; do
   for preset in $presets; do
     run="$out_dir/${log}_${preset}"
     if ! "$evaluate" --bag "$bag" --relations "$relations" --preset "$preset" --quiet \
-         --out "$run.txt" --plot "$run.png" "${extra_args[@]}" >"$run.log" 2>&1; then
+         --out "$run.txt" --trace "$run.trace" --plot "$run.png" "${extra_args[@]}" >"$run.log" 2>&1; then
       printf "%-6s %-8s evaluate failed, see %s\n" "$log" "$preset" "$run.log"
       status=1
       continue
     fi
     summary="$(grep '^SUMMARY' "$run.log" | tail -n1)"
     field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$summary"; }
-    printf "%-6s %-8s %6s %8s%% %21s | %-17s %-17s | %-17s %-17s\n" "$log" "$preset" "$(field scans)" \
+    printf "%-6s %-8s %6s %8s%% %21s | %-17s %-17s | %-17s %-17s | %5s %5s\n" "$log" "$preset" "$(field scans)" \
       "$(field fallback_pct)" "$(field cpu_median_ms)/$(field cpu_p99_ms)/$(field cpu_max_ms)" \
       "$(field short_t) / $(field short_r)" "$(field wheel_short_t) / $(field wheel_short_r)" \
-      "$(field all_t) / $(field all_r)" "$(field wheel_all_t) / $(field wheel_all_r)"
+      "$(field all_t) / $(field all_r)" "$(field wheel_all_t) / $(field wheel_all_r)" \
+      "$(printf %.2f "$(field calibration)")" "$(printf %.2f "$(field worst_leap)")"
   done
 done
 exit $status
