@@ -386,6 +386,17 @@ void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::Pip
   match.status = toMsg(update.match.status);
   match.status_text = hglasm::toString(update.match.status);
   match.jump_rejected = update.jump_rejected;
+  match.prediction_doubted = update.prediction_doubted;
+  match.leap = update.leap;
+  match.leap_probability = finiteFloat(update.leap_probability);
+  match.map_keyframes = static_cast<std::uint32_t>(std::max(0, update.map_keyframes));
+  match.search_box.x = update.search.box.half_x;
+  match.search_box.y = update.search.box.half_y;
+  match.search_box.theta = update.search.box.half_theta;
+  match.search_population = static_cast<std::uint32_t>(std::max(0, update.search.population));
+  match.prior_mahalanobis = finiteFloat(update.prior_mahalanobis);
+  match.noise_scale_xy = finiteFloat(update.noise_scale.xy);
+  match.noise_scale_theta = finiteFloat(update.noise_scale.theta);
   match.deskewed = update.deskewed;
   match.mbicp_status = toMsg(update.match.mbicp_status);
   match.matched = update.matched;
