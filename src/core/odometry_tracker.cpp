@@ -243,11 +243,10 @@ double OdometryTracker::logPrior(const Pose2D& pose, const PosePrior& prior,
   return -0.5 * offset.dot(prior.information * offset) - 0.5 * log_det;
 }
 
-bool OdometryTracker::matchScan(const Scan& scan, const Prediction& prediction,
-                                std::vector<Pose2D>* population_out, TrackerUpdate* update,
-                                Estimate* estimate) {
-  // The prior: the laser's predicted pose in the local map's frame, uncertain by the previous estimate's
-  // uncertainty there plus the motion's noise.
+OdometryTracker::Hypotheses OdometryTracker::hypothesesFor(const Prediction& prediction) const {
+  // The prediction holds: the laser's predicted pose in the local map's frame, uncertain by the previous
+  // estimate's uncertainty there plus the motion's noise.
+  Hypotheses h;
   const Pose2D laser_previous = toMap(pose_);
   const auto to_laser_motion = [this](const Pose2D& base_motion) {
     return laser_mount_.inverse() * base_motion * laser_mount_;
@@ -256,88 +255,116 @@ bool OdometryTracker::matchScan(const Scan& scan, const Prediction& prediction,
   const Eigen::Matrix3d to_laser = jacobianOf(to_laser_motion, prediction.motion);
   const Eigen::Matrix3d zero = Eigen::Matrix3d::Zero();
   const Eigen::Matrix3d previous_part = composeClamped(laser_previous, map_covariance_, laser_motion, zero);
-  const Eigen::Matrix3d motion_part = composeClamped(laser_previous, zero, laser_motion,
-                                                     to_laser * prediction.covariance * to_laser.transpose());
+  h.motion_covariance = composeClamped(laser_previous, zero, laser_motion,
+                                       to_laser * prediction.covariance * to_laser.transpose());
   // Without fusion (an ablation: the match replaces the prediction) the prediction only centres the search.
-  const bool have_prior = options_.fusion && prediction.source != PredictionSource::kNone;
-  Eigen::Matrix3d prior_covariance = previous_part + motion_part;
-  if (!have_prior) {
+  h.informative = options_.fusion && prediction.source != PredictionSource::kNone;
+  h.covariance = previous_part + h.motion_covariance;
+  const double sigmas_sq = options_.search_sigmas * options_.search_sigmas;
+  if (!h.informative) {
     // No motion known yet: flat over the preset's box (its half-widths as search_sigmas sigma).
     const SearchBox& box = options_.matcher.genetic.box;
-    prior_covariance = Eigen::Vector3d(box.half_x, box.half_y, box.half_theta).cwiseAbs2().asDiagonal();
-    prior_covariance /= options_.search_sigmas * options_.search_sigmas;
+    h.covariance = Eigen::Vector3d(box.half_x, box.half_y, box.half_theta).cwiseAbs2().asDiagonal();
+    h.covariance /= sigmas_sq;
   }
-  PosePrior prior;
-  prior.mean = laser_previous * laser_motion;
-  prior.information = informationOf(prior_covariance);
-
-  update->search = searchEffort(prior_covariance, have_prior);
-  Candidate chosen = evaluate(
-      scan,
-      matcher_.match(scan, prior.mean, population_out, &update->search, options_.fusion ? &prior : nullptr),
-      prior);
-  // Two hypotheses: the prediction holds (its noise model), or it is wrong (wheel slip, a glitch, a
-  // kidnap) and the pose can be anywhere in the preset's box. Their prior odds follow the last scan's: a
-  // prediction that was wrong tends to stay wrong for a while.
-  const double wrong_prior = std::clamp(
+  h.prior.mean = laser_previous * laser_motion;
+  h.prior.information = informationOf(h.covariance);
+  // The prediction is wrong (wheel slip, a glitch, a kidnap): the pose can be anywhere in the preset's box.
+  // The prior odds follow the last scan's: a prediction that was wrong tends to stay wrong for a while.
+  h.wide_search = searchEffort(h.covariance, false);
+  const SearchBox& wide_box = h.wide_search.box;
+  h.wide_covariance = h.covariance;
+  h.wide_covariance.diagonal() +=
+      Eigen::Vector3d(wide_box.half_x, wide_box.half_y, wide_box.half_theta).cwiseAbs2() / sigmas_sq;
+  h.wide_prior = PosePrior{h.prior.mean, informationOf(h.wide_covariance)};
+  h.wrong_probability = std::clamp(
       (1.0 - prediction_wrong_) * options_.leap_probability + prediction_wrong_ * options_.leap_persistence,
       1e-12, 1.0 - 1e-12);
-  const SearchEffort wide = searchEffort(prior_covariance, false);
-  Eigen::Matrix3d wide_covariance = prior_covariance;
-  wide_covariance.diagonal() +=
-      Eigen::Vector3d(wide.box.half_x, wide.box.half_y, wide.box.half_theta).cwiseAbs2() /
-      (options_.search_sigmas * options_.search_sigmas);
-  const PosePrior wide_prior{prior.mean, informationOf(wide_covariance)};
+  return h;
+}
+
+void OdometryTracker::scoreHypotheses(const Scan& scan, const Hypotheses& h, const MatchResult& match,
+                                      double* holds, double* wrong) const {
   // Each hypothesis' evidence for a match, in the Laplace approximation: the scan's likelihood at the pose,
   // the hypothesis' prior density there, and the volume of the posterior around it (a hypothesis that
   // leaves a direction to the scan, and the scan leaves it open too, loses no probability for it).
-  const auto hypothesis_scores = [&](const MatchResult& match, double* holds, double* wrong) {
-    const double likelihood = scanLogLikelihood(scan, match.pose);
-    const auto log_volume = [&](const PosePrior& hypothesis) {
-      const Eigen::Matrix3d posterior = informationOf(match.scan_information + hypothesis.information);
-      return 0.5 * std::log(std::max((2.0 * M_PI * posterior).determinant(), 1e-300));
-    };
-    *holds = likelihood + logPrior(match.pose, prior, prior_covariance) + log_volume(prior) +
-             std::log1p(-wrong_prior);
-    *wrong = likelihood + logPrior(match.pose, wide_prior, wide_covariance) + log_volume(wide_prior) +
-             std::log(wrong_prior);
+  const double likelihood = scanLogLikelihood(scan, match.pose);
+  const auto log_volume = [&](const PosePrior& hypothesis) {
+    const Eigen::Matrix3d posterior = informationOf(match.scan_information + hypothesis.information);
+    return 0.5 * std::log(std::max((2.0 * M_PI * posterior).determinant(), 1e-300));
   };
+  *holds = likelihood + logPrior(match.pose, h.prior, h.covariance) + log_volume(h.prior) +
+           std::log1p(-h.wrong_probability);
+  *wrong = likelihood + logPrior(match.pose, h.wide_prior, h.wide_covariance) + log_volume(h.wide_prior) +
+           std::log(h.wrong_probability);
+}
+
+void OdometryTracker::testLeap(const Scan& scan, const Hypotheses& h, std::vector<Pose2D>* population_out,
+                               Candidate* chosen, TrackerUpdate* update) {
   double holds = 0.0, wrong = 0.0;
-  prediction_wrong_ = wrong_prior;
-  if (have_prior && chosen.acceptable) {
-    hypothesis_scores(chosen.match, &holds, &wrong);
+  prediction_wrong_ = h.wrong_probability;
+  if (h.informative && chosen->acceptable) {
+    scoreHypotheses(scan, h, chosen->match, &holds, &wrong);
     prediction_wrong_ = 1.0 / (1.0 + std::exp(holds - wrong));
   }
-  if (have_prior && usesGeneticStage(options_.matcher.algorithm) &&
-      predictionInDoubt(chosen, prior, prior_covariance)) {
-    // Search the preset's whole box under the second hypothesis; the matches compete by posterior.
-    update->prediction_doubted = true;
-    std::vector<Pose2D> wide_population;
-    Candidate leap = evaluate(
-        scan,
-        matcher_.match(scan, prior.mean, population_out ? &wide_population : nullptr, &wide, &wide_prior),
-        prior);
-    const double stay_score = chosen.acceptable ? std::max(holds, wrong) : -HUGE_VAL;
-    double leap_holds = -HUGE_VAL, leap_wrong = -HUGE_VAL;
-    if (leap.acceptable) hypothesis_scores(leap.match, &leap_holds, &leap_wrong);
-    const bool leap_is_far = leap.mahalanobis_sq > options_.max_mahalanobis * options_.max_mahalanobis;
-    if (std::max(leap_holds, leap_wrong) > stay_score) {
-      leap.match.prealign_ms += chosen.match.prealign_ms;
-      leap.match.refine_ms += chosen.match.refine_ms;
-      leap.match.evaluations += chosen.match.evaluations;
-      update->leap = leap_is_far;
-      update->search = wide;
-      chosen = leap;
-      prediction_wrong_ = 1.0 / (1.0 + std::exp(leap_holds - leap_wrong));
-      if (population_out) *population_out = wide_population;
-    } else {
-      update->jump_rejected = leap.acceptable && leap_is_far;
-      chosen.match.prealign_ms += leap.match.prealign_ms;
-      chosen.match.refine_ms += leap.match.refine_ms;
-      chosen.match.evaluations += leap.match.evaluations;
-    }
+  if (!h.informative || !usesGeneticStage(options_.matcher.algorithm) ||
+      !predictionInDoubt(*chosen, h.prior, h.covariance)) {
+    return;
   }
-  if (!chosen.acceptable) prediction_wrong_ = wrong_prior;
+  // Search the preset's whole box under the second hypothesis; the matches compete by posterior.
+  update->prediction_doubted = true;
+  std::vector<Pose2D> wide_population;
+  Candidate leap = evaluate(scan,
+                            matcher_.match(scan, h.prior.mean, population_out ? &wide_population : nullptr,
+                                           &h.wide_search, &h.wide_prior),
+                            h.prior);
+  const double stay_score = chosen->acceptable ? std::max(holds, wrong) : -HUGE_VAL;
+  double leap_holds = -HUGE_VAL, leap_wrong = -HUGE_VAL;
+  if (leap.acceptable) scoreHypotheses(scan, h, leap.match, &leap_holds, &leap_wrong);
+  const bool leap_is_far = leap.mahalanobis_sq > options_.max_mahalanobis * options_.max_mahalanobis;
+  Candidate* loser = &leap;
+  if (std::max(leap_holds, leap_wrong) > stay_score) {
+    std::swap(*chosen, leap);
+    update->leap = leap_is_far;
+    update->search = h.wide_search;
+    prediction_wrong_ = 1.0 / (1.0 + std::exp(leap_holds - leap_wrong));
+    if (population_out) *population_out = wide_population;
+  } else {
+    update->jump_rejected = leap.acceptable && leap_is_far;
+  }
+  // Both searches cost time and evaluations.
+  chosen->match.prealign_ms += loser->match.prealign_ms;
+  chosen->match.refine_ms += loser->match.refine_ms;
+  chosen->match.evaluations += loser->match.evaluations;
+}
+
+void OdometryTracker::estimateFrom(const Candidate& chosen, const Hypotheses& h, Estimate* estimate) const {
+  estimate->laser_in_map = chosen.match.pose;
+  estimate->map_covariance = symmetricClamped(chosen.match.covariance);
+  // The increment's uncertainty: the scan's information fused with the motion's noise alone (the previous
+  // pose's uncertainty is the trajectory's, already counted): the scan decides where it constrains the
+  // pose, the wheels where it does not (along a corridor).
+  const Eigen::Matrix3d increment_in_map =
+      h.informative ? informationOf(chosen.match.scan_information + informationOf(h.motion_covariance))
+                    : estimate->map_covariance;
+  const Pose2D previous = pose_;
+  const Eigen::Matrix3d to_increment = jacobianOf(
+      [&](const Pose2D& laser) { return relativePose(previous, fromMap(laser)); }, chosen.match.pose);
+  estimate->increment_covariance =
+      symmetricClamped(to_increment * increment_in_map * to_increment.transpose());
+}
+
+bool OdometryTracker::matchScan(const Scan& scan, const Prediction& prediction,
+                                std::vector<Pose2D>* population_out, TrackerUpdate* update,
+                                Estimate* estimate) {
+  const Hypotheses h = hypothesesFor(prediction);
+  update->search = searchEffort(h.covariance, h.informative);
+  Candidate chosen = evaluate(scan,
+                              matcher_.match(scan, h.prior.mean, population_out, &update->search,
+                                             options_.fusion ? &h.prior : nullptr),
+                              h.prior);
+  testLeap(scan, h, population_out, &chosen, update);
+  if (!chosen.acceptable) prediction_wrong_ = h.wrong_probability;
   update->leap_probability = prediction_wrong_;
   update->match = chosen.match;
   update->prior_mahalanobis = std::sqrt(chosen.mahalanobis_sq);
@@ -347,20 +374,7 @@ bool OdometryTracker::matchScan(const Scan& scan, const Prediction& prediction,
   if (!chosen.acceptable) return false;
   update->fitness_ratio = chosen.fitness_ratio;
   fitness_.add(chosen.fitness_ratio);
-
-  estimate->laser_in_map = chosen.match.pose;
-  estimate->map_covariance = symmetricClamped(chosen.match.covariance);
-  // The increment's uncertainty: the scan's information fused with the motion's noise alone (the previous
-  // pose's uncertainty is the trajectory's, already counted): the scan decides where it constrains the
-  // pose, the wheels where it does not (along a corridor).
-  const Eigen::Matrix3d increment_in_map =
-      have_prior ? informationOf(chosen.match.scan_information + informationOf(motion_part))
-                 : estimate->map_covariance;
-  const Pose2D previous = pose_;
-  const Eigen::Matrix3d to_increment = jacobianOf(
-      [&](const Pose2D& laser) { return relativePose(previous, fromMap(laser)); }, chosen.match.pose);
-  estimate->increment_covariance =
-      symmetricClamped(to_increment * increment_in_map * to_increment.transpose());
+  estimateFrom(chosen, h, estimate);
   if (!update->leap) {
     learnNoise(prediction, chosen.match);
   } else {

@@ -156,7 +156,29 @@ class OdometryTracker {
     double log_posterior = 0.0;
   };
 
+  /// The two hypotheses a scan is matched under: the prediction holds (its prior), or it is wrong (a prior
+  /// as wide as the preset's box), with the prior probability of the second.
+  struct Hypotheses {
+    bool informative = false;  ///< fusion on and a motion predicted: the prior holds information
+    PosePrior prior;           ///< the laser's predicted pose in the local map's frame
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d motion_covariance = Eigen::Matrix3d::Zero();  ///< the motion's part of it alone
+    SearchEffort wide_search;                                     ///< the preset's whole box
+    PosePrior wide_prior;
+    Eigen::Matrix3d wide_covariance = Eigen::Matrix3d::Zero();
+    double wrong_probability = 0.0;
+  };
+
   bool handleTime(double stamp, TrackerUpdate* update);
+  Hypotheses hypothesesFor(const Prediction& prediction) const;
+  /// log posterior of a match under each hypothesis (up to a common constant).
+  void scoreHypotheses(const Scan& scan, const Hypotheses& h, const MatchResult& match, double* holds,
+                       double* wrong) const;
+  /// If the prediction is in doubt, searches the preset's box too and keeps the more probable match.
+  void testLeap(const Scan& scan, const Hypotheses& h, std::vector<Pose2D>* population_out, Candidate* chosen,
+                TrackerUpdate* update);
+  /// The new pose and its covariances from the chosen match.
+  void estimateFrom(const Candidate& chosen, const Hypotheses& h, Estimate* estimate) const;
   void initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update);
   Prediction predict(double stamp, std::string* warning) const;
   /// Match against the local map with the prediction as prior; false if the prediction is integrated.
