@@ -50,11 +50,12 @@ void LocalMap::rebuild() {
   }
 }
 
-std::int64_t LocalMap::cellKey(const Eigen::Vector2d& point, int dx, int dy) const {
+std::uint64_t LocalMap::cellKey(const Eigen::Vector2d& point, int dx, int dy) const {
   const double inverse = 1.0 / options_.resolution;
   const std::int64_t cx = static_cast<std::int64_t>(std::floor(point.x() * inverse)) + dx;
   const std::int64_t cy = static_cast<std::int64_t>(std::floor(point.y() * inverse)) + dy;
-  return (cx << 32) ^ (cy & 0xffffffff);
+  // Two's-complement bits of each coordinate, side by side (points are within 1e6 m, so 32 bits each).
+  return (static_cast<std::uint64_t>(cx) << 32) ^ (static_cast<std::uint64_t>(cy) & 0xffffffffu);
 }
 
 bool LocalMap::covered(const Eigen::Vector2d& point) const {

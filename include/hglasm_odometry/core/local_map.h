@@ -54,14 +54,14 @@ class LocalMap {
   /// True if a point of a keyframe added before lies within options_.resolution of `point`.
   bool covered(const Eigen::Vector2d& point) const;
   void remember(const Eigen::Vector2d& point);
-  std::int64_t cellKey(const Eigen::Vector2d& point, int dx, int dy) const;
+  std::uint64_t cellKey(const Eigen::Vector2d& point, int dx, int dy) const;
 
   LocalMapOptions options_;
   std::deque<Keyframe> keyframes_;  // oldest first
   Pose2D frame_;
   ReferencePoints reference_;
   // Scratch of rebuild(): kept points by grid cell (cell side = resolution).
-  std::unordered_map<std::int64_t, std::vector<Eigen::Vector2d>> cells_;
+  std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> cells_;
   std::vector<Eigen::Vector2d> kept_;  // in the keyframe's frame
 };
 
