@@ -80,6 +80,7 @@ std::uint8_t toMsg(hglasm::PredictionSource source) {
 constexpr int kScanSubscriberQueue = 50;
 constexpr int kOdomSubscriberQueue = 200;
 constexpr double kTfRetrySeconds = 0.05;  // wall time between tf lookups while waiting for base -> laser
+constexpr std::size_t kMaxQueuedOdometry = 10000;  // samples kept while the worker waits (100 s at 100 Hz)
 
 }  // namespace
 
@@ -128,68 +129,89 @@ LaserOdometry::~LaserOdometry() {
   reset_service_.shutdown();
   diagnostics_timer_.stop();
   {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
+    std::lock_guard<std::mutex> lock(input_mutex_);
     stop_ = true;
   }
-  queue_cv_.notify_all();
-  odometry_cv_.notify_all();
+  input_cv_.notify_all();
   if (worker_.joinable()) worker_.join();
 }
 
 void LaserOdometry::scanCallback(const sensor_msgs::LaserScanConstPtr& msg) {
   {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    if (queue_.size() >= static_cast<std::size_t>(options_.queue_size)) {
-      queue_.pop_front();  // the oldest scan is the least useful one to a live estimate
+    std::lock_guard<std::mutex> lock(input_mutex_);
+    if (scans_.size() >= static_cast<std::size_t>(options_.queue_size)) {
+      scans_.pop_front();  // the oldest scan is the least useful one to a live estimate
       ++dropped_scans_;
     }
-    queue_.push_back(msg);
+    scans_.push_back(msg);
   }
-  queue_cv_.notify_one();
+  input_cv_.notify_all();
   std::lock_guard<std::mutex> lock(stats_mutex_);
   ++scans_received_;
   last_scan_time_ = ros::WallTime::now();
 }
 
 void LaserOdometry::odomCallback(const nav_msgs::OdometryConstPtr& msg) {
-  hglasm::Pose2D pose;
-  if (!pose2DFromOdometryMsg(*msg, &pose)) {
+  OdometrySample sample;
+  if (!pose2DFromOdometryMsg(*msg, &sample.pose)) {
     warnThrottled("odom_nan", "wheel odometry message with a non-finite pose ignored", 10.0);
     return;
   }
-  const std::string child = stripLeadingSlash(msg->child_frame_id);
-  if (!child.empty() && child != options_.base_frame && !warned_odom_child_frame_) {
-    warned_odom_child_frame_ = true;  // once: the configuration will not change by itself
-    ROS_WARN_STREAM("[" << name_ << "] wheel odometry on " << odom_sub_.getTopic() << " is of frame \""
-                        << child << "\", not of base_frame \"" << options_.base_frame
-                        << "\"; it is used as the motion of base_frame anyway");
-  }
+  sample.stamp = msg->header.stamp.toSec();
+  sample.child_frame = stripLeadingSlash(msg->child_frame_id);
   {
-    std::lock_guard<std::mutex> lock(pipeline_mutex_);
-    pipeline_.addOdometry(msg->header.stamp.toSec(), pose);
+    std::lock_guard<std::mutex> lock(input_mutex_);
+    // The worker takes the samples before every scan; this bound only matters while it waits for tf.
+    if (odometry_.size() >= kMaxQueuedOdometry) odometry_.pop_front();
+    odometry_.push_back(std::move(sample));
   }
-  odometry_cv_.notify_all();
-}
-
-void LaserOdometry::waitForOdometry(double stamp) {
-  std::unique_lock<std::mutex> lock(pipeline_mutex_);
-  const bool ready =
-      odometry_cv_.wait_for(lock, std::chrono::duration<double>(options_.odometry_wait), [this, stamp] {
-        if (pipeline_.odometryReadyFor(stamp)) return true;
-        std::lock_guard<std::mutex> queue_lock(queue_mutex_);
-        return stop_;
-      });
-  // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
-  if (!ready) pipeline_.odometryWaitTimedOut();
+  input_cv_.notify_all();
 }
 
 bool LaserOdometry::resetCallback(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   {
-    std::lock_guard<std::mutex> lock(pipeline_mutex_);
-    pipeline_.reset();
+    std::lock_guard<std::mutex> lock(input_mutex_);
+    reset_requested_ = true;
   }
+  input_cv_.notify_all();
   ROS_INFO_STREAM("[" << name_ << "] reset requested: restarting from the origin at the next scan");
   return true;
+}
+
+void LaserOdometry::takeQueuedInputs() {
+  if (reset_requested_) {
+    pipeline_.reset();
+    reset_requested_ = false;
+  }
+  for (const OdometrySample& sample : odometry_) {
+    if (!sample.child_frame.empty() && sample.child_frame != options_.base_frame &&
+        !warned_odom_child_frame_) {
+      warned_odom_child_frame_ = true;  // once: the configuration will not change by itself
+      ROS_WARN_STREAM("[" << name_ << "] wheel odometry on " << odom_sub_.getTopic() << " is of frame \""
+                          << sample.child_frame << "\", not of base_frame \"" << options_.base_frame
+                          << "\"; it is used as the motion of base_frame anyway");
+    }
+    pipeline_.addOdometry(sample.stamp, sample.pose);
+  }
+  odometry_.clear();
+}
+
+bool LaserOdometry::waitForOdometry(double stamp) {
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                             std::chrono::duration<double>(options_.odometry_wait));
+  std::unique_lock<std::mutex> lock(input_mutex_);
+  while (true) {
+    takeQueuedInputs();
+    if (stop_) return false;
+    if (pipeline_.odometryReadyFor(stamp)) return true;
+    if (input_cv_.wait_until(lock, deadline) == std::cv_status::timeout) {
+      takeQueuedInputs();
+      // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
+      if (!pipeline_.odometryReadyFor(stamp)) pipeline_.odometryWaitTimedOut();
+      return !stop_;
+    }
+  }
 }
 
 void LaserOdometry::warnThrottled(const std::string& key, const std::string& text, double period) {
@@ -224,8 +246,8 @@ bool LaserOdometry::ensureLaserMount(const std::string& laser_frame) {
       {
         std::lock_guard<std::mutex> lock(stats_mutex_);
         tf_wait_text_ = "waiting for tf " + options_.base_frame + " -> " + laser_frame;
+        waiting_for_tf_ = true;
       }
-      waiting_for_tf_ = true;
       warnThrottled("tf_wait", text.str(), options_.tf_warn_period);
       return false;
     }
@@ -234,17 +256,19 @@ bool LaserOdometry::ensureLaserMount(const std::string& laser_frame) {
       warnThrottled("tf_bad",
                     "unusable transform " + options_.base_frame + " -> " + laser_frame + ": " + error,
                     options_.tf_warn_period);
+      std::lock_guard<std::mutex> lock(stats_mutex_);
+      tf_wait_text_ = "unusable tf " + options_.base_frame + " -> " + laser_frame;
       waiting_for_tf_ = true;
       return false;
     }
   }
-  waiting_for_tf_ = false;
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    waiting_for_tf_ = false;
+  }
   have_mount_ = true;
   mount_frame_ = laser_frame;
-  {
-    std::lock_guard<std::mutex> lock(pipeline_mutex_);
-    pipeline_.setLaserMount(mount.base_to_laser, mount.upside_down);
-  }
+  pipeline_.setLaserMount(mount.base_to_laser, mount.upside_down);
   ROS_INFO_STREAM("[" << name_ << "] scan frame \"" << laser_frame << "\" at x " << mount.base_to_laser.x
                       << " m, y " << mount.base_to_laser.y << " m, yaw " << mount.base_to_laser.theta
                       << " rad in \"" << options_.base_frame << "\""
@@ -260,43 +284,40 @@ void LaserOdometry::workerLoop() {
   while (true) {
     sensor_msgs::LaserScanConstPtr msg;
     {
-      std::unique_lock<std::mutex> lock(queue_mutex_);
-      queue_cv_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      std::unique_lock<std::mutex> lock(input_mutex_);
+      input_cv_.wait(lock, [this] { return stop_ || !scans_.empty(); });
       if (stop_) return;
-      msg = queue_.front();
-      queue_.pop_front();
+      msg = scans_.front();
+      scans_.pop_front();
     }
     if (!ensureLaserMount(stripLeadingSlash(msg->header.frame_id))) {
       // Hold the scan (at the front, unless the queue filled up meanwhile: then it is the oldest and
       // is dropped) and retry shortly.
-      std::unique_lock<std::mutex> lock(queue_mutex_);
-      if (queue_.size() < static_cast<std::size_t>(options_.queue_size)) {
-        queue_.push_front(msg);
+      std::unique_lock<std::mutex> lock(input_mutex_);
+      if (scans_.size() < static_cast<std::size_t>(options_.queue_size)) {
+        scans_.push_front(msg);
       } else {
         ++dropped_scans_;
       }
-      queue_cv_.wait_for(lock, std::chrono::duration<double>(kTfRetrySeconds), [this] { return stop_; });
+      input_cv_.wait_for(lock, std::chrono::duration<double>(kTfRetrySeconds), [this] { return stop_; });
       if (stop_) return;
       continue;
     }
+    if (!waitForOdometry(msg->header.stamp.toSec())) return;
     processScan(*msg);
   }
 }
 
 void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
   const double stamp = msg.header.stamp.toSec();
-  waitForOdometry(stamp);
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = threadCpuMs();
 
   std::vector<hglasm::Pose2D> population;
   const bool want_population = options_.publish_population && population_pub_.getNumSubscribers() > 0;
   const hglasm::RangeScan ranges = rangeScanFromMsg(msg);
-  hglasm::PipelineUpdate result;
-  {
-    std::lock_guard<std::mutex> lock(pipeline_mutex_);
-    result = pipeline_.processScan(stamp, ranges, want_population ? &population : nullptr);
-  }
+  const hglasm::PipelineUpdate result =
+      pipeline_.processScan(stamp, ranges, want_population ? &population : nullptr);
   const hglasm::TrackerUpdate& update = result.tracker;
   if (result.scan_error_changed) {
     // One message per change of state, not per scan.
@@ -422,7 +443,7 @@ void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::Pip
   match.refine_ms = finiteFloat(update.match.refine_ms);
   match.total_ms = finiteFloat(total_ms);
   {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
+    std::lock_guard<std::mutex> lock(input_mutex_);
     match.dropped_scans = dropped_scans_;
   }
   match_pub_.publish(match);
@@ -485,8 +506,8 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   std::size_t queued = 0;
   std::uint32_t dropped_total = 0;
   {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    queued = queue_.size();
+    std::lock_guard<std::mutex> lock(input_mutex_);
+    queued = scans_.size();
     dropped_total = dropped_scans_;
   }
   std::lock_guard<std::mutex> lock(stats_mutex_);

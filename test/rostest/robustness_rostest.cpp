@@ -855,6 +855,56 @@ TEST(Robustness, BadParametersRefuseToStartWithOneErrorNamingTheParameter) {
   expectBTracks("B after the bad nodelets");
 }
 
+TEST(Robustness, UnloadingWhileWaitingForOdometryTakesUnderASecond) {
+  // A nodelet told to wait up to 10 s for wheel odometry stamped after each scan gets one odometry
+  // sample, then a scan stamped after it: its worker waits. Unloading must wake it at once.
+  const std::string name = "/odo_wait";
+  std::string manager_name = "/robustness_manager";
+  ros::NodeHandle("~").getParam("manager", manager_name);
+  ASSERT_TRUE(ros::service::waitForService(manager_name + "/load_nodelet", ros::Duration(10.0)));
+  ros::param::set(name + "/odometry/wait", 10.0);
+  ros::param::set(name + "/scan/sweep_time", 0.0);
+  ros::param::set(name + "/base_frame", std::string("base_w"));
+  ros::param::set(name + "/odom_frame", std::string("odom_w"));
+  nodelet::NodeletLoad load;
+  load.request.name = name;
+  load.request.type = "hglasm_odometry/LaserOdometryNodelet";
+  load.request.remap_source_args = {"scan", "odom"};
+  load.request.remap_target_args = {"/w/scan", "/w/wheel_odom"};
+  ASSERT_TRUE(ros::service::call(manager_name + "/load_nodelet", load));
+  ASSERT_TRUE(load.response.success);
+
+  ros::NodeHandle nh;
+  ros::Publisher odom_pub = nh.advertise<nav_msgs::Odometry>("/w/wheel_odom", 10);
+  ros::Publisher scan_pub = nh.advertise<sensor_msgs::LaserScan>("/w/scan", 10);
+  const ros::WallTime connect_deadline = ros::WallTime::now() + ros::WallDuration(10.0);
+  while ((odom_pub.getNumSubscribers() == 0 || scan_pub.getNumSubscribers() == 0) &&
+         ros::WallTime::now() < connect_deadline) {
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_GT(scan_pub.getNumSubscribers(), 0u);
+  nav_msgs::Odometry odom;
+  odom.header.stamp = ros::Time(kStampOrigin);
+  odom.header.frame_id = "odom_w";
+  odom.child_frame_id = "base_w";
+  odom.pose.pose.orientation.w = 1.0;
+  odom_pub.publish(odom);
+  ros::WallDuration(0.2).sleep();
+  // In the base frame: no tf needed.
+  scan_pub.publish(scanMsg(hglasm_test::room(), Pose2D(), hglasm_test::halfCircleLaser(),
+                           ros::Time(kStampOrigin + 0.5), "base_w"));
+  ros::WallDuration(1.0).sleep();  // the worker now waits for odometry stamped after 0.5 s
+
+  nodelet::NodeletUnload unload;
+  unload.request.name = name;
+  const ros::WallTime start = ros::WallTime::now();
+  ASSERT_TRUE(ros::service::call(manager_name + "/unload_nodelet", unload));
+  const double seconds = (ros::WallTime::now() - start).toSec();
+  std::printf("[measured] unloading while waiting for odometry took %.3f s\n", seconds);
+  EXPECT_TRUE(unload.response.success);
+  EXPECT_LT(seconds, 1.0);
+}
+
 // ------------------------------------------------------------------ the overload suite
 
 /// Resident memory of the process whose command line contains `needle` (kB), 0 if not found.

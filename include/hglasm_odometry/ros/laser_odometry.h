@@ -2,13 +2,14 @@
 // diagnostics out. Shared by the nodelet and the node; holds no global state, so several instances can
 // live in one process.
 //
-// Threads: the subscription callbacks only enqueue scans (a bounded queue that drops the oldest scan and
-// counts it) and feed wheel odometry to the pipeline; one worker thread per instance waits for odometry
-// (hglasm::OdometryPipeline's feeding policy), converts, matches and publishes. The pipeline is guarded
-// by a mutex shared by the worker, the odometry callback and ~reset.
+// Threads: the subscription callbacks and ~reset only enqueue (scans in a bounded queue that drops the
+// oldest and counts it, wheel-odometry samples, a reset request) under one mutex and wake the worker
+// through one condition variable. One worker thread per instance owns the pipeline: it takes what was
+// queued, waits for odometry (hglasm::OdometryPipeline's feeding policy), converts, matches and
+// publishes. Every wait of the worker is on that condition variable with stop_ in its predicate, so
+// unloading never waits out a timeout.
 #pragma once
 
-#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -60,10 +61,20 @@ class LaserOdometry {
   bool resetCallback(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
+  /// A wheel-odometry sample as the callback received it.
+  struct OdometrySample {
+    double stamp = 0.0;
+    hglasm::Pose2D pose;
+    std::string child_frame;
+  };
+
   void workerLoop();
+  /// Hands the queued odometry and a requested reset to the pipeline. Called by the worker, `lock` held.
+  void takeQueuedInputs();
   /// Waits (bounded by options_.odometry_wait) until the pipeline's feeding policy lets a scan at `stamp`
-  /// be processed (wheel odometry at or after it has arrived, or none is to be expected).
-  void waitForOdometry(double stamp);
+  /// be processed (wheel odometry at or after it has arrived, or none is to be expected). False if the
+  /// worker is to stop.
+  bool waitForOdometry(double stamp);
   /// Looks up base -> laser for `laser_frame` (cached); false while tf does not have it yet.
   bool ensureLaserMount(const std::string& laser_frame);
   void processScan(const sensor_msgs::LaserScan& msg);
@@ -78,19 +89,17 @@ class LaserOdometry {
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
 
-  // The pipeline, fed from several threads; odometry_cv_ (on pipeline_mutex_) signals new odometry.
-  std::mutex pipeline_mutex_;
-  std::condition_variable odometry_cv_;
-  hglasm::OdometryPipeline pipeline_;
-
-  // Bounded input queue (scan callback -> worker).
-  std::mutex queue_mutex_;
-  std::condition_variable queue_cv_;
-  std::deque<sensor_msgs::LaserScanConstPtr> queue_;
+  // What the callbacks hand to the worker (guarded by input_mutex_; input_cv_ wakes the worker).
+  std::mutex input_mutex_;
+  std::condition_variable input_cv_;
+  std::deque<sensor_msgs::LaserScanConstPtr> scans_;  // bounded by options_.queue_size
+  std::deque<OdometrySample> odometry_;
   std::uint32_t dropped_scans_ = 0;
+  bool reset_requested_ = false;
   bool stop_ = false;
 
-  // Worker-only state.
+  // Worker-only state (no lock: only the worker thread touches it).
+  hglasm::OdometryPipeline pipeline_;
   bool have_mount_ = false;
   std::string mount_frame_;
   std::deque<geometry_msgs::PoseStamped> path_;
@@ -105,10 +114,11 @@ class LaserOdometry {
   std::uint64_t resets_ = 0;
   std::uint32_t last_reported_drops_ = 0;  // dropped_scans_ at the previous diagnostics report
   ros::WallTime last_scan_time_;
-  std::atomic<bool> waiting_for_tf_{false};
+  bool waiting_for_tf_ = false;
   std::string tf_wait_text_;
 
-  // Log throttling (per instance; rosconsole's THROTTLE macros share one timer between instances).
+  // Log throttling (per instance; rosconsole's THROTTLE macros share one timer between instances); guarded
+  // by log_mutex_ (the odometry callback and the worker both warn).
   std::mutex log_mutex_;
   std::map<std::string, ros::WallTime> last_warning_;
 
