@@ -10,7 +10,7 @@
 namespace hglasm {
 namespace {
 
-constexpr double kMaxVariance = 1e4;
+constexpr double kMaxVariance = kUnknownVariance;
 // The velocity is the motion over the last kVelocityBaseline seconds or more: some logs hold bursts of
 // scans ~1 ms apart whose stamps do not match their motion, and a per-step velocity would explode.
 constexpr double kVelocityBaseline = 0.1;  // seconds

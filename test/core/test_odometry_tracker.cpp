@@ -138,6 +138,19 @@ TEST(OdometryTracker, FirstScanIsPublishedAtTheOrigin) {
   EXPECT_EQ(first.pose.x, 0.0);
   EXPECT_EQ(first.pose.y, 0.0);
   EXPECT_EQ(first.pose.theta, 0.0);
+  // No velocity is known yet: its covariance says so (not an identity that claims 1 m/s).
+  EXPECT_EQ(first.velocity_covariance, Eigen::Matrix3d::Identity() * hglasm::kUnknownVariance);
+}
+
+TEST(OdometryTracker, AfterAResetTheVelocityIsUnknownAgain) {
+  SimulatedRobot robot(TrackerOptions(), circlePath);
+  TrackerUpdate update;
+  for (int i = 0; i <= 10; ++i) update = robot.step(0.1 * i);
+  EXPECT_LT(update.velocity_covariance(0, 0), 1.0) << "a second of motion: the velocity is known";
+  robot.tracker().reset();
+  update = robot.step(1.1);
+  EXPECT_TRUE(update.reset);
+  EXPECT_EQ(update.velocity_covariance, Eigen::Matrix3d::Identity() * hglasm::kUnknownVariance);
 }
 
 /// Drives `seconds` at 10 Hz; returns the final update. Every update must be sane and matched.

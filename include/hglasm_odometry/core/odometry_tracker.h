@@ -69,6 +69,9 @@ struct TrackerOptions {
   double likelihood_outlier = 0.1;
 };
 
+/// The variance published for what is not known (a covariance must stay finite).
+constexpr double kUnknownVariance = 1e4;
+
 enum class PredictionSource { kOdometry, kConstantVelocity, kNone };
 const char* toString(PredictionSource source);
 
@@ -82,7 +85,9 @@ struct TrackerUpdate {
   /// uncertainty this scan adds; pose_covariance is these composed.
   Eigen::Matrix3d increment_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< vx, vy, wz in the base frame
-  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Identity();
+  /// Unknown (kUnknownVariance on the diagonal) until the velocity has a baseline: the first scans, after
+  /// a reset.
+  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Identity() * kUnknownVariance;
   MatchResult match;           ///< raw matcher output (laser frame, local map's frame)
   double fitness_ratio = 0.0;  ///< fitness ratio of the scan at the estimated pose (fine table)
   Pose2D guess;                ///< predicted pose of the base (odometry frame) before matching
