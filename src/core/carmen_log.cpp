@@ -1,6 +1,8 @@
 #include "hglasm_odometry/core/carmen_log.h"
 
+#include <cctype>
 #include <charconv>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <string_view>
@@ -25,13 +27,20 @@ void splitFields(const std::string& line, std::vector<std::string_view>* fields)
   }
 }
 
-// Locale-independent and strict: the whole field must be a number (NaN and inf included).
+// Strict: the whole field must be a number (NaN and inf included). strtod, not std::from_chars: GCC 9's
+// libstdc++ (ROS Noetic on Ubuntu 20.04) has no floating-point from_chars. strtod reads the decimal point
+// of the C locale, which these programs never change.
 bool parseDouble(std::string_view field, double* value) {
-  if (!field.empty() && field.front() == '+') field.remove_prefix(1);
-  if (field.empty()) return false;
-  const char* end = field.data() + field.size();
-  const auto result = std::from_chars(field.data(), end, *value);
-  return result.ec == std::errc() && result.ptr == end;
+  constexpr std::size_t kMaxField = 64;  // far longer than any number in a log
+  if (field.empty() || field.size() >= kMaxField || std::isspace(static_cast<unsigned char>(field.front()))) {
+    return false;
+  }
+  char text[kMaxField];
+  field.copy(text, field.size());
+  text[field.size()] = '\0';
+  char* end = nullptr;
+  *value = std::strtod(text, &end);
+  return end == text + field.size();
 }
 
 bool parseLong(std::string_view field, long* value) {
