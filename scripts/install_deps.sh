@@ -9,7 +9,7 @@ PACKAGES=(
   build-essential cmake catkin ros-message-generation ros-message-runtime
   # ROS 1 C++ libraries
   libroscpp-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
-  libtf2-ros-dev libtf2-eigen-dev libtf2-geometry-msgs-dev libdiagnostic-updater-dev
+  libtf2-ros-dev libtf2-geometry-msgs-dev libdiagnostic-updater-dev
   libstd-msgs-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev
   libstd-srvs-dev libvisualization-msgs-dev libdiagnostic-msgs-dev
   librosbag-dev librostest-dev libgtest-dev libbenchmark-dev libeigen3-dev
@@ -21,7 +21,7 @@ PACKAGES=(
   # plots, headless rviz and screenshots
   gnuplot-nox rviz xvfb x11-apps imagemagick libgl1-mesa-dri
   # sanitizers and fuzzing
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev clang-format
 )
 
 missing=()

@@ -1,12 +1,23 @@
 #!/usr/bin/env bash
-# THE test command: installs what is missing (apt, Debian package names), builds in Release, and runs
-# every test: core gtests, ROS-layer gtests, rostests on the bags in bags/, the launch-file check, the
-# core tests again under AddressSanitizer + UndefinedBehaviorSanitizer, and a bounded libFuzzer run.
+# THE test command: installs what is missing (apt, Debian package names), checks the formatting, builds in
+# Release, and runs every test: core gtests, ROS-layer gtests, rostests on the bags in bags/, the
+# launch-file check, the core tests again under AddressSanitizer + UndefinedBehaviorSanitizer, and a
+# bounded libFuzzer run.
 # Exits non-zero on any failure. Usage (as root on Debian 12): bash scripts/run_tests.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 source scripts/env.sh
+
+echo "== format: every C++ file as .clang-format says"
+unformatted=()
+while IFS= read -r file; do
+  clang-format --dry-run -Werror "$file" >/dev/null 2>&1 || unformatted+=("$file")
+done < <(git -C "$HGLASM_ROOT" ls-files '*.cpp' '*.h' 2>/dev/null || find src include test -name '*.cpp' -o -name '*.h')
+if ((${#unformatted[@]})); then
+  echo "not formatted (clang-format -i them): ${unformatted[*]}" >&2
+  exit 1
+fi
 
 echo "== build (Release) into $HGLASM_BUILD"
 hglasm_build
