@@ -1,26 +1,31 @@
 #!/usr/bin/env bash
-# Reproduces the papers' Success-Ratio experiments on real scans (intel and fr079 by default) with the
-# `success_ratio` command, all algorithms and presets, and prints one summary table.
+# Reproduces the papers' Success-Ratio experiments on real scans (intel, fr079 and aces by default) with
+# the `success_ratio` command, all algorithms (PGA and HPGA included) and presets, and prints one summary
+# table with each log's ceiling (success at zero initial error).
 #
 # Per log, two runs (same seed, so a case draws the same trials in both):
 #   1. headline: 20 deg + 0.57 m and errors uniform in each preset's whole box (--in-box), HEADLINE
-#      trials per cell, plus the GA-alone curves of pre-alignment success vs fitness evaluations
-#      (GLASM-g vs binary GLASM, the papers' Figures 5/6), CURVE trials per point;
+#      trials per cell, every algorithm, with the ceiling beside every cell; plus the GA-alone curves of
+#      pre-alignment success and mean / median errors vs fitness evaluations (GLASM-g, binary GLASM and
+#      PGA: the papers' Figure 5) and the time each needs to reach 50..95 % (Figure 6), CURVE trials per
+#      point;
 #   2. sweep: the papers' grid, rotation 0..180 deg x translation 0.14/0.57/1.13/2.12 m (52 cases),
-#      SWEEP trials per cell (fewer, to keep the runtime sane), with the Figures 7/8 plots.
-# Outputs in OUT_DIR/<log>/: headline.csv, headline_evaluations.csv, sweep.csv, *.log and plots/*.png;
-# the summary in OUT_DIR/summary.txt.
-# Runtime on the 2-core development machine with the defaults: about 8 min (about 4 min of CPU per
-# bag; -s 500: about 15 min).
+#      SWEEP trials per cell (fewer, to keep the runtime sane), with the Figures 7/8 plots; the lookup-
+#      table algorithms and MbICP only (SWEEP_ALGORITHMS: PGA's search costs 10x theirs).
+# fr079 (interlaced sweeps, odd beams 14 ms after the even ones) also gets its ceiling with the interlace
+# accounted for: --interlace-seconds 0.014, the turn rate from the bag's wheel odometry.
+# Outputs in OUT_DIR/<log>/: headline.csv, headline_evaluations.csv, headline_time_to_reach.csv,
+# sweep.csv, ceiling_interlace.csv (fr079), *.log and plots/*.png; the summary in OUT_DIR/summary.txt.
+# Runtime on the 2-core development machine with the defaults: see the README ("Success ratio").
 #
 # usage: scripts/success_ratio_experiments.sh [-e BIN] [-b BUILD_DIR] [-d DATASETS] [-o OUT_DIR]
-#            [-l "intel fr079"] [-n HEADLINE] [-s SWEEP] [-c CURVE] [-S SEED]
+#            [-l "intel fr079 aces"] [-n HEADLINE] [-s SWEEP] [-c CURVE] [-S SEED]
 #   -e  the success_ratio binary (default: $SUCCESS_RATIO; otherwise it is built, see -b)
 #   -b  catkin build directory to build success_ratio in (default: $HGLASM_BUILD, else <package>/build,
 #       as scripts/env.sh; configured with plain cmake if it has no CMakeCache.txt)
 #   -d  datasets folder (default: <package>/../shared/datasets)
 #   -o  output folder (default: <package>/output/success_ratio)
-#   -l  logs: any of intel fr079 laserazos (default: "intel fr079")
+#   -l  logs: any of intel fr079 aces laserazos (default: "intel fr079 aces")
 #   -n  trials per headline and in-box cell (default 500)
 #   -s  trials per sweep cell (default 200; 0 skips the sweep; -s 500 gives every cell 500 trials)
 #   -c  trials per point of the fitness-evaluation curves (default 500)
@@ -35,13 +40,14 @@ binary="${SUCCESS_RATIO:-}"
 build_dir="${HGLASM_BUILD:-$package_dir/build}"
 datasets="$package_dir/../shared/datasets"
 out_dir="$package_dir/output/success_ratio"
-logs="intel fr079"
+logs="intel fr079 aces"
+sweep_algorithms="hglasm_g,hglasm_binary,glasm_g,glasm_binary,mbicp"
 headline_trials=500
 sweep_trials=200
 curve_trials=500
 seed=1
 
-usage() { sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,34p' "$0" | sed 's/^# \{0,1\}//'; }
 while getopts "e:b:d:o:l:n:s:c:S:h" option; do
   case "$option" in
     e) binary="$OPTARG" ;;
@@ -81,8 +87,9 @@ set_input() {  # sets `input` to the input flags of one log
   case "$1" in
     intel) input=(--bag "$datasets/intel/intel.orig.bag") ;;
     fr079) input=(--bag "$datasets/fr079/fr079.orig.bag") ;;
+    aces) input=(--bag "$datasets/aces/aces.orig.bag") ;;
     laserazos) input=(--carmen "$datasets/laserazos/laserazosSM3.log") ;;
-    *) echo "success_ratio_experiments: unknown log '$1' (intel, fr079, laserazos)" >&2; exit 2 ;;
+    *) echo "success_ratio_experiments: unknown log '$1' (intel, fr079, aces, laserazos)" >&2; exit 2 ;;
   esac
   [[ -f "${input[1]}" ]] || { echo "success_ratio_experiments: missing ${input[1]}" >&2; exit 2; }
 }
@@ -100,11 +107,20 @@ for log in $logs; do
   "$binary" "${input[@]}" --trials "$headline_trials" --seed "$seed" --cases 20:0.57 --in-box \
     --curve-trials "$curve_trials" --csv "$dir/headline.csv" --plots "$dir/plots" --title "$log" \
     2> >(tee "$dir/headline.log" >&2)
-  timings+="$log headline+in-box+curves: $((SECONDS - start)) s"$'\n'
+  timings+="$log headline+in-box+ceiling+curves: $((SECONDS - start)) s"$'\n'
+  if [[ "$log" == fr079 ]]; then
+    echo "== $log: ceiling with the interlace accounted for (odd beams 14 ms after the even ones)" >&2
+    start=$SECONDS
+    "$binary" "${input[@]}" --trials "$headline_trials" --seed "$seed" --cases 0:0 --no-ceiling \
+      --curve-trials 0 --interlace-seconds 0.014 --csv "$dir/ceiling_interlace.csv" \
+      2> >(tee "$dir/ceiling_interlace.log" >&2)
+    timings+="$log ceiling with interlace: $((SECONDS - start)) s"$'\n'
+  fi
   if ((sweep_trials > 0)); then
     echo "== $log: sweep of the papers' 52 cases, $sweep_trials trials" >&2
     start=$SECONDS
     "$binary" "${input[@]}" --trials "$sweep_trials" --seed "$seed" --cases paper --curve-trials 0 \
+      --algorithms "$sweep_algorithms" \
       --csv "$dir/sweep.csv" --plots "$dir/plots" --title "$log" 2> >(tee "$dir/sweep.log" >&2)
     timings+="$log sweep: $((SECONDS - start)) s"$'\n'
   fi
@@ -113,59 +129,85 @@ wait  # the tee processes
 
 summary() {
   echo "Success-Ratio experiments (seed $seed; success = |dxy| < 0.10 m and |dtheta| < 0.01 rad after MbICP,"
-  echo "0.30 m and 0.1 rad for the GA alone: glasm_g, glasm_binary). ms = mean wall time per match,"
-  echo "lookup-table build included, one thread."
+  echo "0.30 m and 0.1 rad for the GA alone: glasm_g, glasm_binary, pga). ms = mean wall time per match,"
+  echo "reference preparation (lookup tables; PGA: the angular sort) included, one thread. ceiling = success"
+  echo "of the same algorithm and preset at zero initial error (the halves matched from the identity)."
   for log in $logs; do
     dir="$out_dir/$log"
     echo
     echo "== $log: 20 deg + 0.57 m and in-box (errors uniform in the preset's box), $headline_trials trials per cell"
-    awk -F, 'NR > 1 {
+    interlace="$dir/ceiling_interlace.csv"
+    [[ -f "$interlace" && "$log" == fr079 ]] || interlace=/dev/null
+    awk -F, 'FNR == 1 { file++; next }
+      file == 1 { ceiling_interlace[$1 " " $2] = sprintf("%5.1f%%", 100 * $7); next }
+      {
         key = $1 " " $2; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
         cell = ($3 == "box") ? "box" : "head"
         text[key, cell] = sprintf("%5.1f%% %6.3f %6.2f %7.2f", 100 * $7, $8, $9, $10)
+        ceiling[key] = ($11 == "") ? "  -" : sprintf("%5.1f%%", 100 * $11)
       }
       END {
-        printf "%-14s %-6s | %-31s | %-31s\n", "algorithm", "preset", "20deg+0.57m: succ dxy(m) dth(deg) ms", "in-box: succ dxy(m) dth(deg) ms"
+        has_interlace = length(ceiling_interlace) > 0
+        printf "%-14s %-6s | %-31s | %-31s | %7s%s\n", "algorithm", "preset", "20deg+0.57m: succ dxy(m) dth(deg) ms", "in-box: succ dxy(m) dth(deg) ms", "ceiling", has_interlace ? "  ceiling(interlace 14 ms)" : ""
         for (i = 1; i <= n; ++i) {
           split(order[i], part, " ")
-          printf "%-14s %-6s | %-36s | %s\n", part[1], part[2], text[order[i], "head"], text[order[i], "box"]
+          printf "%-14s %-6s | %-36s | %-31s | %7s", part[1], part[2], text[order[i], "head"], text[order[i], "box"], ceiling[order[i]]
+          if (has_interlace) printf "  %s", ceiling_interlace[order[i]]
+          printf "\n"
         }
-      }' "$dir/headline.csv"
+      }' "$interlace" "$dir/headline.csv"
     if [[ -f "$dir/headline_evaluations.csv" ]]; then
       echo
-      echo "-- $log: GA alone, pre-alignment success vs fitness evaluations (errors uniform in the box, $curve_trials trials)"
-      # The two tables' GAs spend slightly different evaluations per generation count (elitism, the final
-      # polish), so binary GLASM's success is read off its curve at GLASM-g's evaluation count (linear
-      # interpolation between its neighbouring points; points outside its range are not compared).
-      awk -F, 'NR > 1 {
+      echo "-- $log: GA alone, pre-alignment success and median errors vs fitness evaluations (errors uniform in the box, $curve_trials trials)"
+      # The GAs spend slightly different evaluations per generation count (elitism, the final polish), so
+      # binary GLASM's and PGA's success is read off their curves at GLASM-g's evaluation count (linear
+      # interpolation between neighbouring points; points outside a curve's range are not compared).
+      awk -F, 'function at(preset, algorithm, e,    j, n, e0, e1) {
+          n = count[preset, algorithm]
+          for (j = 1; j < n; ++j) {
+            e0 = ev[preset, algorithm, j]; e1 = ev[preset, algorithm, j + 1]
+            if (e >= e0 && e <= e1 && e1 > e0)
+              return su[preset, algorithm, j] + (e - e0) / (e1 - e0) * (su[preset, algorithm, j + 1] - su[preset, algorithm, j])
+          }
+          return "none"
+        }
+        NR > 1 {
           preset = $2
           if (!(preset in seen)) { seen[preset] = 1; presets[++np] = preset }
           k = ++count[preset, $1]
           gen[preset, $1, k] = $4; ev[preset, $1, k] = $7; su[preset, $1, k] = 100 * $9
+          md[preset, $1, k] = sprintf("%.3f/%.2f", $13, $14)
         }
         END {
-          printf "%-6s %4s %8s | %8s %16s %7s\n", "preset", "gen", "evals", "GLASM-g", "binary@same evals", "diff"
+          printf "%-6s %4s %8s | %8s %9s %9s | %14s %14s %14s\n", "preset", "gen", "evals", "GLASM-g", "binary@=", "PGA@=", "g med m/deg", "bin med", "PGA med"
           for (p = 1; p <= np; ++p) {
-            preset = presets[p]; nb = count[preset, "glasm_binary"]
+            preset = presets[p]
             for (i = 1; i <= count[preset, "glasm_g"]; ++i) {
-              e = ev[preset, "glasm_g", i]; b = "none"
-              for (j = 1; j < nb; ++j) {
-                e0 = ev[preset, "glasm_binary", j]; e1 = ev[preset, "glasm_binary", j + 1]
-                if (e >= e0 && e <= e1 && e1 > e0) {
-                  b = su[preset, "glasm_binary", j] + (e - e0) / (e1 - e0) * (su[preset, "glasm_binary", j + 1] - su[preset, "glasm_binary", j])
-                  break
-                }
-              }
-              if (b == "none") {
-                printf "%-6s %4s %8.0f | %7.1f%% %16s\n", preset, gen[preset, "glasm_g", i], e, su[preset, "glasm_g", i], "(out of range)"
-                continue
-              }
-              d = su[preset, "glasm_g", i] - b; n++; wins += (d > 0.05); ties += (d >= -0.05 && d <= 0.05); total += d
-              printf "%-6s %4s %8.0f | %7.1f%% %15.1f%% %+6.1f\n", preset, gen[preset, "glasm_g", i], e, su[preset, "glasm_g", i], b, d
+              e = ev[preset, "glasm_g", i]; g = su[preset, "glasm_g", i]
+              b = at(preset, "glasm_binary", e); q = at(preset, "pga", e)
+              printf "%-6s %4s %8.0f | %7.1f%% %9s %9s | %14s %14s %14s\n", preset, gen[preset, "glasm_g", i], e, g, \
+                (b == "none") ? "-" : sprintf("%.1f%%", b), (q == "none") ? "-" : sprintf("%.1f%%", q), \
+                md[preset, "glasm_g", i], md[preset, "glasm_binary", i], md[preset, "pga", i]
+              if (b != "none") { nb++; db += g - b; wb += (g - b > 0.05); lb += (g - b < -0.05) }
+              if (q != "none") { nq++; dq += g - q; wq += (g - q > 0.05); lq += (g - q < -0.05) }
             }
           }
-          if (n > 0) printf "GLASM-g ahead at %d of %d equal-evaluation points (%d ties), mean difference %+.1f points\n", wins, n, ties, total / n
+          if (nb > 0) printf "GLASM-g vs binary GLASM at equal evaluations: ahead at %d, behind at %d of %d points, mean %+.1f points\n", wb, lb, nb, db / nb
+          if (nq > 0) printf "GLASM-g vs PGA at equal evaluations: ahead at %d, behind at %d of %d points, mean %+.1f points\n", wq, lq, nq, dq / nq
         }' "$dir/headline_evaluations.csv"
+    fi
+    if [[ -f "$dir/headline_time_to_reach.csv" ]]; then
+      echo
+      echo "-- $log: GA alone, ms per match to reach a success ratio (fewest generations reaching it; search only / with preparation)"
+      awk -F, 'NR > 1 {
+          key = $2 " " $1; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
+          if (!($3 in lseen)) { lseen[$3] = 1; levels[++m] = $3 }
+          cell[key, $3] = ($4 == 1) ? sprintf("%.2f/%.2f", $8, $9) : "not reached"
+        }
+        END {
+          printf "%-20s", "preset algorithm"; for (j = 1; j <= m; ++j) printf " %13s", (100 * levels[j]) "%"; printf "\n"
+          for (i = 1; i <= n; ++i) { printf "%-20s", order[i]; for (j = 1; j <= m; ++j) printf " %13s", cell[order[i], levels[j]]; printf "\n" }
+        }' "$dir/headline_time_to_reach.csv"
     fi
     if [[ -f "$dir/sweep.csv" ]] && ((sweep_trials > 0)); then
       for translation in 0.57 2.12; do
@@ -185,7 +227,8 @@ summary() {
       done
     fi
     echo
-    echo "plots: $dir/plots/success_<algorithm>_<preset>.png (Figures 7/8), $dir/plots/evaluations_<preset>.png (Figures 5/6)"
+    echo "plots: $dir/plots/success_<algorithm>_<preset>.png (Figures 7/8), $dir/plots/evaluations_<preset>.png (Figure 5),"
+    echo "       $dir/plots/time_to_reach.png (Figure 6)"
   done
   echo
   echo "runtime:"

@@ -115,24 +115,41 @@ GeneticAligner::GeneticAligner(const GeneticOptions& options) : options_(options
   options_.tournament_size = std::max(1, options_.tournament_size);
 }
 
+const std::vector<Eigen::Vector2d>& GeneticAligner::fitnessSubset(
+    const std::vector<Eigen::Vector2d>& all_points) {
+  const std::size_t limit =
+      options_.max_points > 0 ? static_cast<std::size_t>(options_.max_points) : all_points.size();
+  if (all_points.size() <= limit) return all_points;
+  subset_.clear();
+  for (std::size_t i = 0; i < limit; ++i) subset_.push_back(all_points[i * all_points.size() / limit]);
+  return subset_;
+}
+
 PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector<Eigen::Vector2d>& all_points,
                                      const Pose2D& guess, std::vector<Pose2D>* population_out,
                                      const LookupTable* coarse_table, const SearchEffort* effort_override) {
-  const SearchEffort effort = effort_override ? sanitised(*effort_override) : effortOf(options_);
-  const std::size_t limit =
-      options_.max_points > 0 ? static_cast<std::size_t>(options_.max_points) : all_points.size();
-  const std::vector<Eigen::Vector2d>* selected = &all_points;
-  if (all_points.size() > limit) {
-    subset_.clear();
-    for (std::size_t i = 0; i < limit; ++i) subset_.push_back(all_points[i * all_points.size() / limit]);
-    selected = &subset_;
-  }
   FitnessPoints& points = prepared_;
-  points.assign(*selected);
+  points.assign(fitnessSubset(all_points));
+  FitnessStages stages;
+  stages.fine = [&table, &points](const Pose2D& pose) { return table.fitness(points, pose); };
+  if (coarse_table && !coarse_table->empty()) {
+    stages.coarse = [coarse_table, &points](const Pose2D& pose) {
+      return coarse_table->fitness(points, pose);
+    };
+  }
+  stages.polish_step = table.options().cell_size;
+  stages.max_fitness = static_cast<double>(table.maxCellValue()) * static_cast<double>(points.size());
+  return align(stages, guess, population_out, effort_override);
+}
+
+PreAlignResult GeneticAligner::align(const FitnessStages& stages, const Pose2D& guess,
+                                     std::vector<Pose2D>* population_out,
+                                     const SearchEffort* effort_override) {
+  const SearchEffort effort = effort_override ? sanitised(*effort_override) : effortOf(options_);
   PreAlignResult result;
   result.pose = guess;
   // The guess itself competes: the GA never returns something worse than the prediction.
-  result.fitness = table.fitness(points, guess);
+  result.fitness = stages.fine(guess);
   result.evaluations = 1;
 
   const Codec codec(effort.box, guess, options_.bits_per_gene);
@@ -145,10 +162,10 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
   std::vector<Individual> population(population_size), offspring(population_size);
   std::vector<int> slices;
   const int elite_count = std::clamp(options_.elite_count, 1, population_size - 1);
-  const int coarse_generations = coarse_table && !coarse_table->empty() ? effort.coarse_generations : 0;
-  const LookupTable* scoring = &table;
+  const int coarse_generations = stages.coarse ? effort.coarse_generations : 0;
+  const PoseFitness* scoring = &stages.fine;
   auto evaluate = [&](Individual& individual) {
-    individual.fitness = scoring->fitness(points, codec.decode(individual.chromosome));
+    individual.fitness = (*scoring)(codec.decode(individual.chromosome));
     ++result.evaluations;
   };
   auto tournament = [&]() -> const Individual& {
@@ -176,12 +193,12 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
   std::vector<Individual> best_run_population;
   std::uint32_t best_run_fitness = 0;
   for (int run = 0; run < effort.runs; ++run) {
-    scoring = coarse_generations > 0 ? coarse_table : &table;
+    scoring = coarse_generations > 0 ? &stages.coarse : &stages.fine;
     seedLatinHypercube(options_.bits_per_gene, rng_, &slices, &population);
     for (auto& individual : population) evaluate(individual);
     for (int generation = 1; generation < effort.generations; ++generation) {
       if (generation == coarse_generations) {
-        scoring = &table;  // switch to the fine table: rescore the survivors on it
+        scoring = &stages.fine;  // switch to the fine fitness: rescore the survivors on it
         for (auto& individual : population) evaluate(individual);
       }
       // Elitism: the best individuals survive unchanged (no re-evaluation needed).
@@ -220,19 +237,19 @@ PreAlignResult GeneticAligner::align(const LookupTable& table, const std::vector
     }
   }
 
-  polish(table, points, guess, effort.box, &result);
+  polish(stages.fine, stages.polish_step, guess, effort.box, &result);
 
   if (population_out) {
     population_out->clear();
     for (const auto& individual : best_run_population)
       population_out->push_back(codec.decode(individual.chromosome));
   }
-  const double max_fitness = static_cast<double>(table.maxCellValue()) * static_cast<double>(points.size());
+  const double max_fitness = stages.max_fitness;
   result.fitness_ratio = max_fitness > 0.0 ? result.fitness / max_fitness : 0.0;
   return result;
 }
 
-void GeneticAligner::polish(const LookupTable& table, const FitnessPoints& points, const Pose2D& guess,
+void GeneticAligner::polish(const PoseFitness& fitness_of, double finest_step, const Pose2D& guess,
                             const SearchBox& box, PreAlignResult* result) const {
   // Candidates stay inside the search box around the guess, like every GA individual.
   const auto inside_box = [&](const Pose2D& pose) {
@@ -240,7 +257,7 @@ void GeneticAligner::polish(const LookupTable& table, const FitnessPoints& point
            std::abs(normalizeAngle(pose.theta - guess.theta)) <= box.half_theta;
   };
   // Compass search: try +-step on each axis, move to the first improvement, halve the steps when none.
-  const double cell = table.options().cell_size;
+  const double cell = finest_step;
   double step_xy = 4.0 * cell;
   double step_theta = 0.02;
   int budget = options_.polish_evaluations;
@@ -253,7 +270,7 @@ void GeneticAligner::polish(const LookupTable& table, const FitnessPoints& point
       if (budget-- <= 0) break;
       const Pose2D candidate(centre.x + move.x, centre.y + move.y, centre.theta + move.theta);
       if (!inside_box(candidate)) continue;
-      const std::uint32_t fitness = table.fitness(points, candidate);
+      const std::uint32_t fitness = fitness_of(candidate);
       ++result->evaluations;
       if (fitness > result->fitness) {
         result->fitness = fitness;

@@ -35,13 +35,18 @@ const char* toString(Algorithm algorithm) {
       return "glasm_binary";
     case Algorithm::kMbicp:
       return "mbicp";
+    case Algorithm::kPga:
+      return "pga";
+    case Algorithm::kHpga:
+      return "hpga";
   }
   return "unknown";
 }
 
 bool parseAlgorithm(const std::string& name, Algorithm* algorithm) {
-  for (Algorithm candidate : {Algorithm::kHglasmG, Algorithm::kHglasmBinary, Algorithm::kGlasmG,
-                              Algorithm::kGlasmBinary, Algorithm::kMbicp}) {
+  for (Algorithm candidate :
+       {Algorithm::kHglasmG, Algorithm::kHglasmBinary, Algorithm::kGlasmG, Algorithm::kGlasmBinary,
+        Algorithm::kMbicp, Algorithm::kPga, Algorithm::kHpga}) {
     if (name == toString(candidate)) {
       *algorithm = candidate;
       return true;
@@ -53,7 +58,10 @@ bool parseAlgorithm(const std::string& name, Algorithm* algorithm) {
 bool usesGeneticStage(Algorithm algorithm) { return algorithm != Algorithm::kMbicp; }
 bool usesMbicpStage(Algorithm algorithm) {
   return algorithm == Algorithm::kHglasmG || algorithm == Algorithm::kHglasmBinary ||
-         algorithm == Algorithm::kMbicp;
+         algorithm == Algorithm::kMbicp || algorithm == Algorithm::kHpga;
+}
+bool usesPolarPairing(Algorithm algorithm) {
+  return algorithm == Algorithm::kPga || algorithm == Algorithm::kHpga;
 }
 
 const char* toString(Preset preset) {
@@ -125,6 +133,9 @@ MatcherOptions presetOptions(Preset preset) {
       options.coarse_table = LookupTableOptions{TableKind::kGraded, 0.12, 0.60, 1.20, 0.30, 0.10};
       break;
   }
+  // PGA pairs within the reach of GLASM's tables: the fine table's cut-off, then the coarse one's.
+  options.pga.pairing_threshold = options.table.cutoff;
+  options.pga.coarse_pairing_threshold = options.coarse_table.cutoff;
   return options;
 }
 
@@ -151,7 +162,8 @@ ScanMatcher::ScanMatcher(const MatcherOptions& options)
       table_(tableOptionsFor(options.table, options.algorithm)),
       coarse_table_(tableOptionsFor(options.coarse_table, options.algorithm)),
       aligner_(options.genetic),
-      mbicp_(options.mbicp) {}
+      mbicp_(options.mbicp),
+      polar_pairing_(options.pga) {}
 
 void ScanMatcher::setReference(const Scan& reference) {
   ReferencePoints single;
@@ -161,7 +173,9 @@ void ScanMatcher::setReference(const Scan& reference) {
 
 void ScanMatcher::setReference(const ReferencePoints& reference) {
   const auto start = std::chrono::steady_clock::now();
-  if (usesGeneticStage(options_.algorithm)) {
+  if (usesPolarPairing(options_.algorithm)) {
+    polar_pairing_.build(reference);  // PGA's preparation: sorting the reference by angle
+  } else if (usesGeneticStage(options_.algorithm)) {
     table_.build(reference);
     reference_ = reference;
     coarse_table_stale_ = true;
@@ -192,15 +206,24 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
   if (!startResult(scan, guess, &result)) return result;
   const Pose2D start_pose = result.pose;
 
+  coarse_table_build_ms_ = 0.0;
   if (usesGeneticStage(options_.algorithm)) {
     const auto start = std::chrono::steady_clock::now();
     const int coarse_generations = effort ? effort->coarse_generations : options_.genetic.coarse_generations;
-    if (coarse_generations > 0 && coarse_table_stale_) {
+    const bool polar = usesPolarPairing(options_.algorithm);
+    if (!polar && coarse_generations > 0 && coarse_table_stale_) {
       coarse_table_.build(reference_);
       coarse_table_stale_ = false;
+      coarse_table_build_ms_ = millisecondsSince(start);
     }
-    const PreAlignResult prealigned =
-        aligner_.align(table_, scan.points, start_pose, population_out, &coarse_table_, effort);
+    PreAlignResult prealigned;
+    if (polar) {
+      pga_points_.assign(aligner_.fitnessSubset(scan.points));
+      const FitnessStages stages = polarPairingStages(polar_pairing_, pga_points_, options_.table.cell_size);
+      prealigned = aligner_.align(stages, start_pose, population_out, effort);
+    } else {
+      prealigned = aligner_.align(table_, scan.points, start_pose, population_out, &coarse_table_, effort);
+    }
     result.prealign_ms = millisecondsSince(start);
     result.prealigned_pose = result.pose = prealigned.pose;
     result.fitness = prealigned.fitness;

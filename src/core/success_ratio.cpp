@@ -77,15 +77,20 @@ struct UsableScans {
   std::vector<std::size_t> indices;  // into the caller's scans
 };
 
-TrialPair makePair(const RangeScan& ranges, const ScanConversionOptions& conversion, const Pose2D& truth,
-                   std::uint64_t state) {
+// `half_offset`: the even half's sensor in the odd half's frame (identity when both halves are one instant).
+TrialPair makePair(const RangeScan& ranges, const ScanConversionOptions& conversion, const Pose2D& error,
+                   const Pose2D& half_offset, std::uint64_t state) {
   TrialPair pair;
   const Scan scan = scanFromRanges(ranges, conversion);
   pair.reference = selectBeams(scan, 1);
-  pair.moved = transformScan(selectBeams(scan, 0), truth.inverse());
-  pair.truth = truth;
+  pair.moved = transformScan(selectBeams(scan, 0), error.inverse());
+  pair.truth = half_offset * error;
   pair.ga_seed = mix(state, kGaTag);
   return pair;
+}
+
+Pose2D halfOffsetOf(const SuccessRatioOptions& options, std::size_t scan_index) {
+  return options.half_offsets.empty() ? Pose2D() : options.half_offsets[scan_index];
 }
 
 std::vector<TrialPair> casePairs(const std::vector<RangeScan>& scans, const UsableScans& usable,
@@ -96,7 +101,9 @@ std::vector<TrialPair> casePairs(const std::vector<RangeScan>& scans, const Usab
   for (int trial = 0; trial < trials; ++trial) {
     std::size_t pick = 0;
     const Pose2D error = caseTrialError(ipe, options.seed, trial, usable.indices.size(), &pick);
-    pairs.push_back(makePair(scans[usable.indices[pick]], options.conversion, error, trialState(key, trial)));
+    const std::size_t scan_index = usable.indices[pick];
+    pairs.push_back(makePair(scans[scan_index], options.conversion, error, halfOffsetOf(options, scan_index),
+                             trialState(key, trial)));
   }
   return pairs;
 }
@@ -109,7 +116,9 @@ std::vector<TrialPair> boxPairs(const std::vector<RangeScan>& scans, const Usabl
   for (int trial = 0; trial < trials; ++trial) {
     std::size_t pick = 0;
     const Pose2D error = boxTrialError(box, options.seed, trial, usable.indices.size(), &pick);
-    pairs.push_back(makePair(scans[usable.indices[pick]], options.conversion, error, trialState(key, trial)));
+    const std::size_t scan_index = usable.indices[pick];
+    pairs.push_back(makePair(scans[scan_index], options.conversion, error, halfOffsetOf(options, scan_index),
+                             trialState(key, trial)));
   }
   return pairs;
 }
@@ -120,6 +129,7 @@ struct TrialOutcome {
   double dxy = 0.0;
   double dth = 0.0;
   double ms = 0.0;
+  double preparation_ms = 0.0;  // lookup tables (coarse included) or PGA's angular sort
   int evaluations = 0;
 };
 
@@ -139,6 +149,7 @@ TrialOutcome runTrial(ScanMatcher* matcher, const TrialPair& pair, const Success
 
   TrialOutcome outcome;
   outcome.ms = std::chrono::duration<double, std::milli>(stop - start).count();
+  outcome.preparation_ms = matcher->lastTableBuildMs() + matcher->lastCoarseTableBuildMs();
   outcome.evaluations = result.evaluations;
   const Algorithm algorithm = matcher->options().algorithm;
   const bool judge_prealigned = prealign_only || !usesMbicpStage(algorithm);
@@ -166,9 +177,15 @@ struct Tally {
   double sum_dxy = 0.0;
   double sum_dth = 0.0;
   double sum_ms = 0.0;
+  double sum_preparation_ms = 0.0;
   double sum_evaluations = 0.0;
+  std::vector<double> dxy;  // per trial, for the medians
+  std::vector<double> dth;
 
   void add(const TrialOutcome& outcome) {
+    sum_preparation_ms += outcome.preparation_ms;
+    dxy.push_back(outcome.dxy);
+    dth.push_back(outcome.dth);
     ++trials;
     successes += outcome.success ? 1 : 0;
     failed_status += outcome.failed_status ? 1 : 0;
@@ -178,7 +195,20 @@ struct Tally {
     sum_evaluations += outcome.evaluations;
   }
   double mean(double sum) const { return trials > 0 ? sum / trials : 0.0; }
+  double ratio() const { return trials > 0 ? static_cast<double>(successes) / trials : 0.0; }
 };
+
+// Median (the mean of the middle two for an even count); 0 when empty.
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const std::size_t middle = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle), values.end());
+  const double upper = values[middle];
+  if (values.size() % 2 == 1) return upper;
+  const double lower =
+      *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle));
+  return 0.5 * (lower + upper);
+}
 
 Tally runTrials(ScanMatcher* matcher, const std::vector<TrialPair>& pairs,
                 const SuccessThresholds& thresholds, bool prealign_only) {
@@ -355,14 +385,10 @@ Pose2D boxTrialError(const SearchBox& box, std::uint64_t seed, int trial, std::s
   return Pose2D(x, y, theta);
 }
 
-bool runSuccessRatio(const std::vector<RangeScan>& scans, const SuccessRatioOptions& options,
-                     SuccessRatioReport* report, std::string* error,
-                     const SuccessRatioProgressCallback& progress) {
-  *report = SuccessRatioReport();
-  std::string local_error;
-  if (!error) error = &local_error;
-  if (!validate(options, error)) return false;
+namespace {
 
+// The scans whose odd and even halves both have enough valid points.
+UsableScans usableScans(const std::vector<RangeScan>& scans, const SuccessRatioOptions& options) {
   UsableScans usable;
   for (std::size_t i = 0; i < scans.size(); ++i) {
     ScanError scan_error = ScanError::kNone;
@@ -373,39 +399,76 @@ bool runSuccessRatio(const std::vector<RangeScan>& scans, const SuccessRatioOpti
       usable.indices.push_back(i);
     }
   }
-  report->scans_total = scans.size();
-  report->scans_used = usable.indices.size();
-  report->scans_skipped = scans.size() - usable.indices.size();
-  if (usable.indices.empty()) {
-    *error = "none of the " + std::to_string(scans.size()) + " scans has " +
-             std::to_string(options.min_points_per_half) + " valid points in both its odd and even beams";
-    return false;
-  }
+  return usable;
+}
 
-  // One matcher per (algorithm, preset): the GA and MbICP buffers are reused across trials.
-  std::map<std::pair<Algorithm, Preset>, std::unique_ptr<ScanMatcher>> matchers;
-  for (Algorithm algorithm : options.algorithms) {
-    for (Preset preset : options.presets) {
-      MatcherOptions matcher_options = presetOptions(preset);
-      matcher_options.algorithm = algorithm;
-      matchers[{algorithm, preset}] = std::make_unique<ScanMatcher>(matcher_options);
-    }
-  }
+using MatcherKey = std::pair<Algorithm, Preset>;
+using Matchers = std::map<MatcherKey, std::unique_ptr<ScanMatcher>>;
 
+struct ProgressState {
   SuccessRatioProgress state;
-  const std::size_t cells_per_case = options.algorithms.size() * options.presets.size();
-  state.cells_total = cells_per_case * (options.cases.size() + (options.in_box ? 1 : 0));
-  if (options.curve_trials > 0) {
-    for (Preset preset : options.presets) {
-      state.cells_total += 2 * curveGenerations(options, presetOptions(preset).genetic.generations).size();
-    }
-  }
-  auto report_cell = [&](const std::string& message) {
+  const SuccessRatioProgressCallback* callback = nullptr;
+  void cell(const std::string& message) {
     ++state.cells_done;
     state.message = message;
-    if (progress) progress(state);
-  };
+    if (callback && *callback) (*callback)(state);
+  }
+};
 
+EvaluationCurvePoint curvePoint(Algorithm algorithm, Preset preset, const GeneticOptions& genetic,
+                                int generations, const Tally& tally) {
+  EvaluationCurvePoint point;
+  point.algorithm = algorithm;
+  point.preset = preset;
+  point.population = genetic.population;
+  point.generations = generations;
+  point.runs = genetic.runs;
+  point.trials = tally.trials;
+  point.successes = tally.successes;
+  point.success_ratio = tally.ratio();
+  point.mean_evaluations = tally.mean(tally.sum_evaluations);
+  point.mean_dxy_m = tally.mean(tally.sum_dxy);
+  point.mean_dth_deg = tally.mean(tally.sum_dth) * kRadToDeg;
+  point.mean_ms = tally.mean(tally.sum_ms);
+  point.median_dxy_m = median(tally.dxy);
+  point.median_dth_deg = median(tally.dth) * kRadToDeg;
+  point.mean_search_ms = tally.mean(tally.sum_ms - tally.sum_preparation_ms);
+  return point;
+}
+
+// Figures 5/6: the GA alone at the preset's population and runs, with more and more generations.
+void runCurves(const std::vector<RangeScan>& scans, const UsableScans& usable,
+               const SuccessRatioOptions& options, SuccessRatioReport* report, ProgressState* progress) {
+  for (Preset preset : options.presets) {
+    const MatcherOptions base = presetOptions(preset);
+    const std::vector<TrialPair> pairs =
+        boxPairs(scans, usable, options, base.genetic.box, options.curve_trials);
+    for (Algorithm algorithm : options.curve_algorithms) {
+      for (int generations : curveGenerations(options, base.genetic.generations)) {
+        MatcherOptions matcher_options = base;
+        matcher_options.algorithm = algorithm;
+        matcher_options.genetic.generations = generations;
+        ScanMatcher matcher(matcher_options);
+        const Tally tally = runTrials(&matcher, pairs, options.thresholds, true);
+        const EvaluationCurvePoint point = curvePoint(algorithm, preset, base.genetic, generations, tally);
+        report->curve.push_back(point);
+        char buffer[240];
+        std::snprintf(buffer, sizeof(buffer),
+                      "curve %-12s %-6s gen %2d (%6.0f evals) %4d/%-4d = %5.1f%%  dxy %.3f m  dth %.2f deg  "
+                      "%.2f ms",
+                      toString(algorithm), toString(preset), generations, point.mean_evaluations,
+                      point.successes, point.trials, 100.0 * point.success_ratio, point.mean_dxy_m,
+                      point.mean_dth_deg, point.mean_ms);
+        progress->cell(buffer);
+      }
+    }
+  }
+}
+
+// The fixed cases, then the in-box trials, in algorithm, preset (option order), case order.
+void runRows(const std::vector<RangeScan>& scans, const UsableScans& usable,
+             const SuccessRatioOptions& options, Matchers& matchers, ProgressState* progress,
+             SuccessRatioReport* report) {
   // Rows are computed case by case (each case's pairs are built once and shared by all matchers).
   struct KeyedRow {
     std::size_t algorithm, preset, case_index;
@@ -419,7 +482,7 @@ bool runSuccessRatio(const std::vector<RangeScan>& scans, const SuccessRatioOpti
         const Tally tally = runTrials(matchers[{algorithm, preset}].get(), pairs, options.thresholds, false);
         keyed.push_back({positionOf(options.algorithms, algorithm), positionOf(options.presets, preset), c,
                          makeRow(algorithm, preset, false, options.cases[c], tally)});
-        report_cell(rowMessage(keyed.back().row));
+        progress->cell(rowMessage(keyed.back().row));
       }
     }
   }
@@ -431,7 +494,7 @@ bool runSuccessRatio(const std::vector<RangeScan>& scans, const SuccessRatioOpti
         const Tally tally = runTrials(matchers[{algorithm, preset}].get(), pairs, options.thresholds, false);
         keyed.push_back({positionOf(options.algorithms, algorithm), positionOf(options.presets, preset),
                          options.cases.size(), makeRow(algorithm, preset, true, IpeCase(), tally)});
-        report_cell(rowMessage(keyed.back().row));
+        progress->cell(rowMessage(keyed.back().row));
       }
     }
   }
@@ -441,51 +504,93 @@ bool runSuccessRatio(const std::vector<RangeScan>& scans, const SuccessRatioOpti
     return a.case_index < b.case_index;
   });
   for (const KeyedRow& k : keyed) report->rows.push_back(k.row);
+}
 
-  // Figures 5/6: the GA alone at the preset's population and runs, with more and more generations.
-  if (options.curve_trials > 0) {
-    for (Preset preset : options.presets) {
-      const MatcherOptions base = presetOptions(preset);
-      const std::vector<TrialPair> pairs =
-          boxPairs(scans, usable, options, base.genetic.box, options.curve_trials);
-      for (Algorithm algorithm : {Algorithm::kGlasmG, Algorithm::kGlasmBinary}) {
-        for (int generations : curveGenerations(options, base.genetic.generations)) {
-          MatcherOptions matcher_options = base;
-          matcher_options.algorithm = algorithm;
-          matcher_options.genetic.generations = generations;
-          ScanMatcher matcher(matcher_options);
-          const Tally tally = runTrials(&matcher, pairs, options.thresholds, true);
-          EvaluationCurvePoint point;
-          point.algorithm = algorithm;
-          point.preset = preset;
-          point.population = base.genetic.population;
-          point.generations = generations;
-          point.runs = base.genetic.runs;
-          point.trials = tally.trials;
-          point.successes = tally.successes;
-          point.success_ratio = tally.trials > 0 ? static_cast<double>(tally.successes) / tally.trials : 0.0;
-          point.mean_evaluations = tally.mean(tally.sum_evaluations);
-          point.mean_dxy_m = tally.mean(tally.sum_dxy);
-          point.mean_dth_deg = tally.mean(tally.sum_dth) * kRadToDeg;
-          point.mean_ms = tally.mean(tally.sum_ms);
-          report->curve.push_back(point);
-          char buffer[200];
-          std::snprintf(buffer, sizeof(buffer),
-                        "curve %-12s %-6s gen %2d (%6.0f evals) %4d/%-4d = %5.1f%%  dxy %.3f m  dth %.2f deg",
-                        toString(algorithm), toString(preset), generations, point.mean_evaluations,
-                        point.successes, point.trials, 100.0 * point.success_ratio, point.mean_dxy_m,
-                        point.mean_dth_deg);
-          report_cell(buffer);
-        }
-      }
+// The ceiling of every (algorithm, preset): success at zero initial error, the trials of the case 0:0.
+std::map<MatcherKey, Tally> runCeilings(const std::vector<RangeScan>& scans, const UsableScans& usable,
+                                        const SuccessRatioOptions& options, Matchers& matchers,
+                                        ProgressState* progress) {
+  std::map<MatcherKey, Tally> ceilings;
+  if (!options.ceiling) return ceilings;
+  const IpeCase zero;
+  const std::vector<TrialPair> pairs = casePairs(scans, usable, options, zero, options.trials);
+  for (Preset preset : options.presets) {
+    for (Algorithm algorithm : options.algorithms) {
+      const Tally tally = runTrials(matchers[{algorithm, preset}].get(), pairs, options.thresholds, false);
+      ceilings[{algorithm, preset}] = tally;
+      char buffer[160];
+      std::snprintf(buffer, sizeof(buffer), "%-13s %-6s ceiling (IPE 0) %4d/%-4d = %5.1f%%",
+                    toString(algorithm), toString(preset), tally.successes, tally.trials,
+                    100.0 * tally.ratio());
+      progress->cell(buffer);
     }
   }
+  return ceilings;
+}
+
+}  // namespace
+
+bool runSuccessRatio(const std::vector<RangeScan>& scans, const SuccessRatioOptions& options,
+                     SuccessRatioReport* report, std::string* error,
+                     const SuccessRatioProgressCallback& progress) {
+  *report = SuccessRatioReport();
+  std::string local_error;
+  if (!error) error = &local_error;
+  if (!validate(options, error)) return false;
+  if (!options.half_offsets.empty() && options.half_offsets.size() != scans.size()) {
+    *error = "half-scan offsets: " + std::to_string(options.half_offsets.size()) + " for " +
+             std::to_string(scans.size()) + " scans";
+    return false;
+  }
+
+  const UsableScans usable = usableScans(scans, options);
+  report->scans_total = scans.size();
+  report->scans_used = usable.indices.size();
+  report->scans_skipped = scans.size() - usable.indices.size();
+  if (usable.indices.empty()) {
+    *error = "none of the " + std::to_string(scans.size()) + " scans has " +
+             std::to_string(options.min_points_per_half) + " valid points in both its odd and even beams";
+    return false;
+  }
+
+  // One matcher per (algorithm, preset): the GA and MbICP buffers are reused across trials.
+  Matchers matchers;
+  for (Algorithm algorithm : options.algorithms) {
+    for (Preset preset : options.presets) {
+      MatcherOptions matcher_options = presetOptions(preset);
+      matcher_options.algorithm = algorithm;
+      matchers[{algorithm, preset}] = std::make_unique<ScanMatcher>(matcher_options);
+    }
+  }
+
+  ProgressState tracker;
+  tracker.callback = &progress;
+  const std::size_t cells_per_case = options.algorithms.size() * options.presets.size();
+  tracker.state.cells_total =
+      cells_per_case * (options.cases.size() + (options.in_box ? 1 : 0) + (options.ceiling ? 1 : 0));
+  if (options.curve_trials > 0) {
+    for (Preset preset : options.presets) {
+      tracker.state.cells_total +=
+          options.curve_algorithms.size() *
+          curveGenerations(options, presetOptions(preset).genetic.generations).size();
+    }
+  }
+  const std::map<MatcherKey, Tally> ceilings = runCeilings(scans, usable, options, matchers, &tracker);
+  runRows(scans, usable, options, matchers, &tracker, report);
+  for (SuccessRatioRow& row : report->rows) {
+    const auto found = ceilings.find({row.algorithm, row.preset});
+    if (found == ceilings.end()) continue;
+    row.ceiling = found->second.ratio();
+    row.ceiling_successes = found->second.successes;
+    row.ceiling_trials = found->second.trials;
+  }
+  if (options.curve_trials > 0) runCurves(scans, usable, options, report, &tracker);
   return true;
 }
 
 std::string successRatioCsvHeader() {
   return "algorithm,preset,rot_err_deg,trans_err_m,trials,successes,success_ratio,mean_dxy_m,mean_dth_deg,"
-         "mean_ms";
+         "mean_ms,ceiling";
 }
 
 std::string successRatioCsvLine(const SuccessRatioRow& row) {
@@ -498,13 +603,14 @@ std::string successRatioCsvLine(const SuccessRatioRow& row) {
   }
   line += std::to_string(row.trials) + "," + std::to_string(row.successes) + "," +
           formatNumber("%.4f", row.success_ratio) + "," + formatNumber("%.5f", row.mean_dxy_m) + "," +
-          formatNumber("%.4f", row.mean_dth_deg) + "," + formatNumber("%.4f", row.mean_ms);
+          formatNumber("%.4f", row.mean_dth_deg) + "," + formatNumber("%.4f", row.mean_ms) + ",";
+  if (row.ceiling >= 0.0) line += formatNumber("%.4f", row.ceiling);
   return line;
 }
 
 std::string evaluationCurveCsvHeader() {
   return "algorithm,preset,population,generations,runs,trials,mean_evaluations,successes,success_ratio,"
-         "mean_dxy_m,mean_dth_deg,mean_ms";
+         "mean_dxy_m,mean_dth_deg,mean_ms,median_dxy_m,median_dth_deg,mean_search_ms";
 }
 
 std::string evaluationCurveCsvLine(const EvaluationCurvePoint& point) {
@@ -513,7 +619,68 @@ std::string evaluationCurveCsvLine(const EvaluationCurvePoint& point) {
          std::to_string(point.runs) + "," + std::to_string(point.trials) + "," +
          formatNumber("%.1f", point.mean_evaluations) + "," + std::to_string(point.successes) + "," +
          formatNumber("%.4f", point.success_ratio) + "," + formatNumber("%.5f", point.mean_dxy_m) + "," +
-         formatNumber("%.4f", point.mean_dth_deg) + "," + formatNumber("%.4f", point.mean_ms);
+         formatNumber("%.4f", point.mean_dth_deg) + "," + formatNumber("%.4f", point.mean_ms) + "," +
+         formatNumber("%.5f", point.median_dxy_m) + "," + formatNumber("%.4f", point.median_dth_deg) + "," +
+         formatNumber("%.4f", point.mean_search_ms);
+}
+
+std::string timeToReachCsvHeader() {
+  return "algorithm,preset,level,reached,generations,mean_evaluations,success_ratio,search_ms,total_ms";
+}
+
+std::string timeToReachCsvLine(const TimeToReach& entry) {
+  std::string line = std::string(toString(entry.algorithm)) + "," + toString(entry.preset) + "," +
+                     formatNumber("%.2f", entry.level) + "," + (entry.reached ? "1" : "0") + ",";
+  if (!entry.reached) return line + ",,,,";
+  return line + std::to_string(entry.generations) + "," + formatNumber("%.1f", entry.evaluations) + "," +
+         formatNumber("%.4f", entry.success_ratio) + "," + formatNumber("%.4f", entry.search_ms) + "," +
+         formatNumber("%.4f", entry.total_ms);
+}
+
+std::vector<double> timeToReachLevels() { return {0.50, 0.70, 0.80, 0.90, 0.95}; }
+
+std::vector<TimeToReach> timeToReach(const std::vector<EvaluationCurvePoint>& curve,
+                                     const std::vector<double>& levels) {
+  std::vector<std::pair<Preset, Algorithm>> groups;
+  for (const EvaluationCurvePoint& point : curve) {
+    const std::pair<Preset, Algorithm> group{point.preset, point.algorithm};
+    if (std::find(groups.begin(), groups.end(), group) == groups.end()) groups.push_back(group);
+  }
+  std::vector<TimeToReach> entries;
+  for (const auto& [preset, algorithm] : groups) {
+    for (double level : levels) {
+      TimeToReach entry;
+      entry.algorithm = algorithm;
+      entry.preset = preset;
+      entry.level = level;
+      for (const EvaluationCurvePoint& point : curve) {
+        if (point.preset != preset || point.algorithm != algorithm || point.success_ratio < level) continue;
+        if (entry.reached && point.generations >= entry.generations) continue;
+        entry.reached = true;
+        entry.generations = point.generations;
+        entry.evaluations = point.mean_evaluations;
+        entry.success_ratio = point.success_ratio;
+        entry.search_ms = point.mean_search_ms;
+        entry.total_ms = point.mean_ms;
+      }
+      entries.push_back(entry);
+    }
+  }
+  return entries;
+}
+
+bool writeTimeToReachCsv(const std::string& path, const std::vector<TimeToReach>& entries,
+                         std::string* error) {
+  std::string content = timeToReachCsvHeader() + "\n";
+  for (const TimeToReach& entry : entries) content += timeToReachCsvLine(entry) + "\n";
+  return writeFile(path, content, error);
+}
+
+Pose2D halfScanOffset(const Eigen::Vector3d& base_velocity, const Pose2D& base_to_laser, double seconds) {
+  const Pose2D base_motion(base_velocity.x() * seconds, base_velocity.y() * seconds,
+                           base_velocity.z() * seconds);
+  const Pose2D laser_motion = base_to_laser.inverse() * base_motion * base_to_laser;
+  return laser_motion.inverse();
 }
 
 bool writeSuccessRatioCsv(const std::string& path, const std::vector<SuccessRatioRow>& rows,
@@ -530,12 +697,11 @@ bool writeEvaluationCurveCsv(const std::string& path, const std::vector<Evaluati
   return writeFile(path, content, error);
 }
 
-bool writeSuccessRatioPlotScripts(const SuccessRatioReport& report, const std::string& directory,
-                                  const std::string& title, std::vector<std::string>* scripts,
-                                  std::string* error) {
-  scripts->clear();
-  const std::string prefix = title.empty() ? "" : title + ": ";
+namespace {
 
+// Figures 7/8: success ratio vs rotation error, one plot per (algorithm, preset).
+bool writeRotationPlots(const SuccessRatioReport& report, const std::string& directory,
+                        const std::string& prefix, std::vector<std::string>* scripts, std::string* error) {
   // Figures 7/8: success ratio vs rotation error, one curve per translation error.
   std::vector<std::pair<Algorithm, Preset>> groups;
   for (const SuccessRatioRow& row : report.rows) {
@@ -592,94 +758,217 @@ bool writeSuccessRatioPlotScripts(const SuccessRatioReport& report, const std::s
     scripts->push_back(stem + ".gp");
   }
 
-  // Figures 5/6: pre-alignment success and error vs fitness evaluations, GLASM-g vs binary GLASM.
+  return true;
+}
+
+const char* curveTitle(Algorithm algorithm) {
+  switch (algorithm) {
+    case Algorithm::kGlasmG:
+      return "GLASM-g (graded table)";
+    case Algorithm::kGlasmBinary:
+      return "GLASM (binary table)";
+    case Algorithm::kPga:
+      return "PGA (polar pairing)";
+    default:
+      return toString(algorithm);
+  }
+}
+
+const char* curveStyle(Algorithm algorithm) {
+  switch (algorithm) {
+    case Algorithm::kGlasmG:
+      return "lc rgb '#1f5fbf' pt 7";
+    case Algorithm::kGlasmBinary:
+      return "lc rgb '#c0392b' pt 5";
+    default:
+      return "lc rgb '#2e8b3a' pt 9";
+  }
+}
+
+std::vector<Algorithm> curveAlgorithms(const std::vector<EvaluationCurvePoint>& curve) {
+  std::vector<Algorithm> algorithms;
+  for (const EvaluationCurvePoint& point : curve) {
+    if (std::find(algorithms.begin(), algorithms.end(), point.algorithm) == algorithms.end())
+      algorithms.push_back(point.algorithm);
+  }
+  return algorithms;
+}
+
+// One gnuplot data block per algorithm of `preset`'s curve; `blocks` receives the algorithms in order.
+std::string curveData(const std::vector<EvaluationCurvePoint>& curve, Preset preset,
+                      std::vector<Algorithm>* blocks) {
+  std::string data;
+  for (Algorithm algorithm : curveAlgorithms(curve)) {
+    std::string block;
+    for (const EvaluationCurvePoint& point : curve) {
+      if (point.preset != preset || point.algorithm != algorithm) continue;
+      block += formatNumber("%.1f", point.mean_evaluations) + " " +
+               formatNumber("%.3f", 100.0 * point.success_ratio) + " " +
+               formatNumber("%.5f", point.mean_dxy_m) + " " + formatNumber("%.4f", point.mean_dth_deg) + " " +
+               formatNumber("%.4f", point.mean_ms) + " " + std::to_string(point.generations) + " " +
+               formatNumber("%.5f", point.median_dxy_m) + " " + formatNumber("%.4f", point.median_dth_deg) +
+               " " + formatNumber("%.4f", point.mean_search_ms) + "\n";
+    }
+    if (block.empty()) continue;
+    data += std::string("# ") + toString(algorithm) +
+            ": evaluations success_percent mean_dxy_m mean_dth_deg mean_ms generations median_dxy_m "
+            "median_dth_deg mean_search_ms\n" +
+            block + "\n\n";
+    blocks->push_back(algorithm);
+  }
+  return data;
+}
+
+// Figure 5: per preset, success and mean / median translation and rotation errors vs fitness evaluations.
+bool writeEvaluationPlot(const SuccessRatioReport& report, Preset preset, const std::string& directory,
+                         const std::string& prefix, std::vector<std::string>* scripts, std::string* error) {
+  const std::string stem = directory + "/evaluations_" + toString(preset);
+  std::vector<Algorithm> blocks;
+  const std::string data = curveData(report.curve, preset, &blocks);
+  int population = 0, runs = 0, trials = 0, min_generations = 0, max_generations = 0;
+  double max_evaluations = 0.0, preset_evaluations = 0.0;
+  const int preset_generations = presetOptions(preset).genetic.generations;
+  for (const EvaluationCurvePoint& point : report.curve) {
+    if (point.preset != preset) continue;
+    population = point.population;
+    runs = point.runs;
+    trials = point.trials;
+    min_generations = min_generations == 0 ? point.generations : std::min(min_generations, point.generations);
+    max_generations = std::max(max_generations, point.generations);
+    max_evaluations = std::max(max_evaluations, point.mean_evaluations);
+    if (point.generations == preset_generations) preset_evaluations = point.mean_evaluations;
+  }
+  // Thousands keep the tick labels of the large preset (up to ~10^4 evaluations) apart.
+  const bool thousands = max_evaluations >= 2000.0;
+  const double scale = thousands ? 1000.0 : 1.0;
+  const std::string x_column = thousands ? "($1/1000)" : "1";
+  std::string marker;  // dashed line at the preset's own GA size (Table 1)
+  if (preset_evaluations > 0.0) {
+    const std::string x = formatNumber("%g", preset_evaluations / scale);
+    marker = "set arrow 1 from " + x + ", graph 0 to " + x + ", graph 1 nohead dt 2 lc rgb 'gray40'\n";
+  }
+  // Mean: solid; median: dashed, same colour.
+  auto plot_columns = [&](int mean_column, int median_column) {
+    std::string plot = "plot ";
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      const std::string source =
+          gnuplotQuote(stem + ".dat") + " index " + std::to_string(i) + " using " + x_column + ":";
+      plot += (i == 0 ? "" : ", ") + source + std::to_string(mean_column) + " with linespoints lw 2 " +
+              curveStyle(blocks[i]) + " title " +
+              gnuplotQuote(std::string(curveTitle(blocks[i])) + (median_column > 0 ? " mean" : ""));
+      if (median_column > 0) {
+        plot += ", " + source + std::to_string(median_column) + " with linespoints lw 2 dt 2 " +
+                curveStyle(blocks[i]) + " title " +
+                gnuplotQuote(std::string(curveTitle(blocks[i])) + " median");
+      }
+    }
+    return plot + "\n";
+  };
+  const std::string script =
+      "set terminal pngcairo size 1650,560 noenhanced font 'Sans,11'\nset output " +
+      gnuplotQuote(stem + ".png") + "\nset multiplot layout 1,3 title " +
+      gnuplotQuote(prefix + toString(preset) + " preset box, GA alone (population " +
+                   std::to_string(population) + ", " + std::to_string(runs) + " run(s), " +
+                   std::to_string(min_generations) + ".." + std::to_string(max_generations) +
+                   " generations; dashed vertical: Table 1 size), errors uniform " + "in the box, " +
+                   std::to_string(trials) + " trials per point; success = 0.30 m and 0.1 rad") +
+      "\nset grid\nset xlabel " +
+      gnuplotQuote(thousands ? "fitness evaluations per match (thousands)"
+                             : "fitness evaluations per match") +
+      "\nset key bottom right\n" + marker +
+      "set title 'pre-alignment success ratio'\nset ylabel 'success ratio (%)'\nset yrange [0:105]\n" +
+      plot_columns(2, 0) +
+      "set title 'translation error (solid: mean, dashed: median)'\nset ylabel '|dxy| (m)'\nset logscale y\n"
+      "set yrange [*:*]\nset key top right font ',9'\n" +
+      plot_columns(3, 7) +
+      "set title 'rotation error (solid: mean, dashed: median)'\nset ylabel '|dtheta| (deg)'\n" +
+      plot_columns(4, 8) + "unset multiplot\n";
+  if (!writeFile(stem + ".dat", data, error) || !writeFile(stem + ".gp", script, error)) return false;
+  scripts->push_back(stem + ".gp");
+  return true;
+}
+
+// Figure 6: time per match to reach each success level, one bar per algorithm, preparation excluded (left)
+// and included (right), one row per preset of the curves.
+bool writeTimeToReachPlot(const SuccessRatioReport& report, const std::string& directory,
+                          const std::string& prefix, std::vector<std::string>* scripts, std::string* error) {
+  const std::vector<TimeToReach> entries = timeToReach(report.curve, timeToReachLevels());
+  const std::vector<Algorithm> algorithms = curveAlgorithms(report.curve);
+  std::vector<Preset> presets;
+  for (const EvaluationCurvePoint& point : report.curve) {
+    if (std::find(presets.begin(), presets.end(), point.preset) == presets.end())
+      presets.push_back(point.preset);
+  }
+  const std::string stem = directory + "/time_to_reach";
+  std::string data;
+  for (Preset preset : presets) {
+    data += std::string("# ") + toString(preset) +
+            ": level, then per algorithm search_ms total_ms ('?': not reached)\n";
+    for (double level : timeToReachLevels()) {
+      data += formatNumber("%.0f%%", 100.0 * level);
+      for (Algorithm algorithm : algorithms) {
+        for (const TimeToReach& entry : entries) {
+          if (entry.preset != preset || entry.algorithm != algorithm || entry.level != level) continue;
+          data += entry.reached ? " " + formatNumber("%.4f", entry.search_ms) + " " +
+                                      formatNumber("%.4f", entry.total_ms)
+                                : std::string(" ? ?");
+        }
+      }
+      data += "\n";
+    }
+    data += "\n\n";
+  }
+  std::string script =
+      "set terminal pngcairo size 1400," + std::to_string(120 + 380 * presets.size()) +
+      " noenhanced font 'Sans,11'\nset output " + gnuplotQuote(stem + ".png") + "\nset multiplot layout " +
+      std::to_string(presets.size()) + ",2 title " +
+      gnuplotQuote(prefix +
+                   "GA alone: ms per match to reach a pre-alignment success ratio (fewest "
+                   "generations reaching it; no bar: not reached)") +
+      "\nset style data histogram\nset style histogram clustered gap 1\nset style fill solid 0.85 "
+      "border -1\nset datafile missing '?'\nset logscale y\nset grid ytics\nset yrange [0.01:*]\n"
+      "set key top left\nset xlabel 'success ratio reached'\nset ylabel 'ms per match (log)'\n";
+  for (std::size_t p = 0; p < presets.size(); ++p) {
+    for (int included = 0; included < 2; ++included) {
+      script += "set title " +
+                gnuplotQuote(std::string(toString(presets[p])) + " preset, " +
+                             (included ? "reference preparation included"
+                                       : "reference preparation excluded (as the papers)")) +
+                "\nplot ";
+      for (std::size_t a = 0; a < algorithms.size(); ++a) {
+        const int column = 2 + 2 * static_cast<int>(a) + included;
+        std::string colour = curveStyle(algorithms[a]);
+        colour = colour.substr(0, colour.find(" pt"));
+        script += (a == 0 ? "" : ", ") + gnuplotQuote(stem + ".dat") + " index " + std::to_string(p) +
+                  " using " + std::to_string(column) + ":xtic(1) " + colour + " title " +
+                  gnuplotQuote(curveTitle(algorithms[a]));
+      }
+      script += "\n";
+    }
+  }
+  script += "unset multiplot\n";
+  if (!writeFile(stem + ".dat", data, error) || !writeFile(stem + ".gp", script, error)) return false;
+  scripts->push_back(stem + ".gp");
+  return true;
+}
+
+}  // namespace
+
+bool writeSuccessRatioPlotScripts(const SuccessRatioReport& report, const std::string& directory,
+                                  const std::string& title, std::vector<std::string>* scripts,
+                                  std::string* error) {
+  scripts->clear();
+  const std::string prefix = title.empty() ? "" : title + ": ";
+  if (!writeRotationPlots(report, directory, prefix, scripts, error)) return false;
   std::vector<Preset> presets;
   for (const EvaluationCurvePoint& point : report.curve) {
     if (std::find(presets.begin(), presets.end(), point.preset) == presets.end())
       presets.push_back(point.preset);
   }
   for (Preset preset : presets) {
-    const std::string stem = directory + "/evaluations_" + toString(preset);
-    std::string data;
-    std::vector<std::pair<Algorithm, int>> blocks;  // algorithm, data index
-    int population = 0, runs = 0, trials = 0, min_generations = 0, max_generations = 0;
-    for (Algorithm algorithm : {Algorithm::kGlasmG, Algorithm::kGlasmBinary}) {
-      std::string block;
-      for (const EvaluationCurvePoint& point : report.curve) {
-        if (point.preset != preset || point.algorithm != algorithm) continue;
-        population = point.population;
-        runs = point.runs;
-        trials = point.trials;
-        min_generations =
-            min_generations == 0 ? point.generations : std::min(min_generations, point.generations);
-        max_generations = std::max(max_generations, point.generations);
-        block += formatNumber("%.1f", point.mean_evaluations) + " " +
-                 formatNumber("%.3f", 100.0 * point.success_ratio) + " " +
-                 formatNumber("%.5f", point.mean_dxy_m) + " " + formatNumber("%.4f", point.mean_dth_deg) +
-                 " " + formatNumber("%.4f", point.mean_ms) + " " + std::to_string(point.generations) + "\n";
-      }
-      if (block.empty()) continue;
-      data += std::string("# ") + toString(algorithm) +
-              ": evaluations success_percent mean_dxy_m mean_dth_deg mean_ms generations\n" + block + "\n\n";
-      blocks.emplace_back(algorithm, static_cast<int>(blocks.size()));
-    }
-    // Thousands keep the tick labels of the large preset (up to ~10^4 evaluations) apart.
-    double max_evaluations = 0.0, preset_evaluations = 0.0;
-    const int preset_generations = presetOptions(preset).genetic.generations;
-    for (const EvaluationCurvePoint& point : report.curve) {
-      if (point.preset != preset) continue;
-      max_evaluations = std::max(max_evaluations, point.mean_evaluations);
-      if (point.generations == preset_generations) preset_evaluations = point.mean_evaluations;
-    }
-    const bool thousands = max_evaluations >= 2000.0;
-    const std::string x_column = thousands ? "($1/1000)" : "1";
-    const std::string x_label =
-        thousands ? "fitness evaluations per match (thousands)" : "fitness evaluations per match";
-    std::string marker;  // dashed line at the preset's own GA size (Table 1)
-    if (preset_evaluations > 0.0) {
-      marker = "set arrow 1 from " +
-               formatNumber("%g", thousands ? preset_evaluations / 1000.0 : preset_evaluations) +
-               ", graph 0 to " +
-               formatNumber("%g", thousands ? preset_evaluations / 1000.0 : preset_evaluations) +
-               ", graph 1 nohead dt 2 lc rgb 'gray40'\n"
-               "set label 1 'Table 1 size (" +
-               std::to_string(preset_generations) + " generations)' at " +
-               formatNumber("%g", thousands ? preset_evaluations / 1000.0 : preset_evaluations) +
-               ", graph 0.5 center rotate by 90 offset -0.8,0 tc rgb 'gray40'\n";
-    }
-    auto plot_column = [&](int column) {
-      std::string plot = "plot ";
-      for (std::size_t i = 0; i < blocks.size(); ++i) {
-        const bool graded = blocks[i].first == Algorithm::kGlasmG;
-        plot += (i == 0 ? "" : ", ") + gnuplotQuote(stem + ".dat") + " index " +
-                std::to_string(blocks[i].second) + " using " + x_column + ":" + std::to_string(column) +
-                " with linespoints lw 2 pt " + (graded ? "7" : "5") + " title " +
-                gnuplotQuote(graded ? "GLASM-g (graded table)" : "GLASM (binary table)");
-      }
-      return plot + "\n";
-    };
-    const std::string script =
-        "set terminal pngcairo size 1500,500 noenhanced font 'Sans,11'\n"
-        "set output " +
-        gnuplotQuote(stem + ".png") +
-        "\n"
-        "set multiplot layout 1,3 title " +
-        gnuplotQuote(prefix + toString(preset) + " preset box, GA alone (population " +
-                     std::to_string(population) + ", " + std::to_string(runs) + " run(s), " +
-                     std::to_string(min_generations) + ".." + std::to_string(max_generations) +
-                     " generations), errors uniform in the box, " + std::to_string(trials) +
-                     " trials per point; success = 0.30 m and 0.1 rad") +
-        "\n"
-        "set grid\nset xlabel " +
-        gnuplotQuote(x_label) + "\nset key bottom right\n" + marker +
-        "set title 'pre-alignment success ratio'\nset ylabel 'success ratio (%)'\nset yrange [0:105]\n" +
-        plot_column(2) + "unset label 1\n" +
-        "set title 'mean translation error'\nset ylabel '|dxy| (m)'\nset yrange [0:*]\nset key top right\n" +
-        plot_column(3) + "set title 'mean rotation error'\nset ylabel '|dtheta| (deg)'\nset yrange [0:*]\n" +
-        plot_column(4) + "unset multiplot\n";
-    if (!writeFile(stem + ".dat", data, error) || !writeFile(stem + ".gp", script, error)) return false;
-    scripts->push_back(stem + ".gp");
+    if (!writeEvaluationPlot(report, preset, directory, prefix, scripts, error)) return false;
   }
+  if (!report.curve.empty() && !writeTimeToReachPlot(report, directory, prefix, scripts, error)) return false;
   return true;
 }
 

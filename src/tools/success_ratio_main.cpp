@@ -39,11 +39,11 @@ const char kUsage[] =
     "  --trials N               trials per (algorithm, preset, case)\n"
     "  --seed S                 random seed (unsigned integer)\n"
     "  --csv PATH               result rows: algorithm,preset,rot_err_deg,trans_err_m,trials,successes,\n"
-    "                           success_ratio,mean_dxy_m,mean_dth_deg,mean_ms\n"
+    "                           success_ratio,mean_dxy_m,mean_dth_deg,mean_ms,ceiling\n"
     "  --plots DIR              write PNGs (gnuplot): success vs rotation error per algorithm+preset,\n"
     "                           pre-alignment vs fitness evaluations per preset\n"
-    "  --algorithms LIST        comma list of hglasm_g,hglasm_binary,glasm_g,glasm_binary,mbicp (default "
-    "all)\n"
+    "  --algorithms LIST        comma list of hglasm_g,hglasm_binary,glasm_g,glasm_binary,mbicp,pga,hpga\n"
+    "                           (default all)\n"
     "  --presets LIST           comma list of small,medium,large (default all)\n"
     "  --cases C                paper (default: rotation 0..180 deg x translation 0.14,0.57,1.13,2.12 m),\n"
     "                           none, or ROT_DEG:TRANS_M,... e.g. 20:0.57,90:1.13\n"
@@ -53,6 +53,13 @@ const char kUsage[] =
     "                           0 = skip the curves)\n"
     "  --curve-generations LIST generation counts of the curves (default 1,2,3,4,6,8,... up to 2x preset)\n"
     "  --curve-csv PATH         curve rows (default: --csv with _evaluations.csv instead of .csv)\n"
+    "  --curve-algorithms LIST  GA-alone algorithms of the curves (default glasm_g,glasm_binary,pga)\n"
+    "  --time-csv PATH          time to reach 50/70/80/90/95 % from the curves (default: --csv with\n"
+    "                           _time_to_reach.csv instead of .csv)\n"
+    "  --no-ceiling             skip the ceiling (success at zero initial error, per algorithm and preset)\n"
+    "  --interlace-seconds S    the odd beams are recorded S s after the even ones (fr079: 0.014): the\n"
+    "                           truth of each trial is rotated (and moved) by the laser's motion over S,\n"
+    "                           from the bag's wheel odometry at the scan (--bag only)\n"
     "  --max-scans N            read only the first N scans (default all)\n"
     "  --min-points N           skip scans with fewer valid points in their odd or even beams (default 40)\n"
     "  --angle-min A            override the first beam angle (radians)\n"
@@ -72,7 +79,11 @@ struct Arguments {
   bool seed_given = false;
   std::string csv;
   std::string plots;
-  std::string algorithms = "hglasm_g,hglasm_binary,glasm_g,glasm_binary,mbicp";
+  std::string algorithms = "hglasm_g,hglasm_binary,glasm_g,glasm_binary,mbicp,pga,hpga";
+  std::string curve_algorithms = "glasm_g,glasm_binary,pga";
+  std::string time_csv;
+  bool ceiling = true;
+  double interlace_seconds = 0.0;
   std::string presets = "small,medium,large";
   std::string cases = "paper";
   bool in_box = false;
@@ -139,6 +150,8 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
       args->in_box = true;
     } else if (flag == "--quiet") {
       args->quiet = true;
+    } else if (flag == "--no-ceiling") {
+      args->ceiling = false;
     } else if (!value()) {
       if (flag.rfind("--", 0) != 0) return fail("unexpected argument '" + flag + "'");
       const bool known = flag == "--bag" || flag == "--topic" || flag == "--carmen" || flag == "--trials" ||
@@ -146,7 +159,8 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
                          flag == "--presets" || flag == "--cases" || flag == "--curve-trials" ||
                          flag == "--curve-generations" || flag == "--curve-csv" || flag == "--max-scans" ||
                          flag == "--min-points" || flag == "--angle-min" || flag == "--angle-increment" ||
-                         flag == "--title";
+                         flag == "--title" || flag == "--curve-algorithms" || flag == "--time-csv" ||
+                         flag == "--interlace-seconds";
       return known ? needs_value() : fail("unknown option '" + flag + "'");
     } else if (flag == "--bag") {
       args->bag = text;
@@ -199,6 +213,13 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
       args->override_increment = true;
     } else if (flag == "--title") {
       args->title = text;
+    } else if (flag == "--curve-algorithms") {
+      args->curve_algorithms = text;
+    } else if (flag == "--time-csv") {
+      args->time_csv = text;
+    } else if (flag == "--interlace-seconds") {
+      if (!parseFinite(text, &args->interlace_seconds))
+        return fail("--interlace-seconds: not a number: '" + text + "'");
     } else {
       return fail("unknown option '" + flag + "'");
     }
@@ -209,20 +230,34 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
   if (!args->trials_given) return fail("--trials N is required");
   if (!args->seed_given) return fail("--seed S is required");
   if (args->csv.empty()) return fail("--csv PATH is required");
+  if (args->interlace_seconds != 0.0 && args->bag.empty())
+    return fail("--interlace-seconds needs --bag (the turn rate comes from its wheel odometry)");
+  return true;
+}
+
+bool parseAlgorithms(const std::string& flag, const std::string& list,
+                     std::vector<hglasm::Algorithm>* algorithms) {
+  algorithms->clear();
+  for (const std::string& name : splitList(list)) {
+    hglasm::Algorithm algorithm;
+    if (!hglasm::parseAlgorithm(name, &algorithm)) {
+      return fail(flag + ": unknown algorithm '" + name +
+                  "' (hglasm_g, hglasm_binary, glasm_g, glasm_binary, mbicp, pga, hpga)");
+    }
+    if (std::find(algorithms->begin(), algorithms->end(), algorithm) == algorithms->end())
+      algorithms->push_back(algorithm);
+  }
   return true;
 }
 
 bool buildOptions(const Arguments& args, hglasm::SuccessRatioOptions* options) {
-  for (const std::string& name : splitList(args.algorithms)) {
-    hglasm::Algorithm algorithm;
-    if (!hglasm::parseAlgorithm(name, &algorithm)) {
-      return fail("unknown algorithm '" + name + "' (hglasm_g, hglasm_binary, glasm_g, glasm_binary, mbicp)");
-    }
-    if (std::find(options->algorithms.begin(), options->algorithms.end(), algorithm) ==
-        options->algorithms.end()) {
-      options->algorithms.push_back(algorithm);
-    }
+  if (!parseAlgorithms("--algorithms", args.algorithms, &options->algorithms)) return false;
+  if (!parseAlgorithms("--curve-algorithms", args.curve_algorithms, &options->curve_algorithms)) return false;
+  for (hglasm::Algorithm algorithm : options->curve_algorithms) {
+    if (hglasm::usesMbicpStage(algorithm) || !hglasm::usesGeneticStage(algorithm))
+      return fail("--curve-algorithms: the curves are of GA-alone algorithms (glasm_g, glasm_binary, pga)");
   }
+  options->ceiling = args.ceiling;
   for (const std::string& name : splitList(args.presets)) {
     hglasm::Preset preset;
     if (!hglasm::parsePreset(name, &preset))
@@ -253,7 +288,25 @@ bool buildOptions(const Arguments& args, hglasm::SuccessRatioOptions* options) {
   return true;
 }
 
-bool readScans(const Arguments& args, std::vector<hglasm::RangeScan>* scans) {
+// The base's velocity (vx, vy, omega in its own frame) at `stamp`: the wheel odometry's motion between the
+// samples around it; zero when there are fewer than two samples.
+Eigen::Vector3d baseVelocityAt(const std::vector<hglasm_odometry::BagOdometry>& odometry, double stamp) {
+  if (odometry.size() < 2) return Eigen::Vector3d::Zero();
+  const auto after =
+      std::upper_bound(odometry.begin(), odometry.end(), stamp,
+                       [](double t, const hglasm_odometry::BagOdometry& o) { return t < o.stamp; });
+  std::size_t next = static_cast<std::size_t>(after - odometry.begin());
+  next = std::clamp<std::size_t>(next, 1, odometry.size() - 1);
+  const hglasm_odometry::BagOdometry& a = odometry[next - 1];
+  const hglasm_odometry::BagOdometry& b = odometry[next];
+  const double dt = b.stamp - a.stamp;
+  if (!(dt > 0.0)) return Eigen::Vector3d::Zero();
+  const hglasm::Pose2D motion = hglasm::relativePose(a.pose, b.pose);
+  return Eigen::Vector3d(motion.x, motion.y, motion.theta) / dt;
+}
+
+bool readScans(const Arguments& args, std::vector<hglasm::RangeScan>* scans,
+               std::vector<hglasm::Pose2D>* half_offsets) {
   std::string error;
   if (!args.carmen.empty()) {
     hglasm::CarmenLogOptions log_options;
@@ -270,12 +323,21 @@ bool readScans(const Arguments& args, std::vector<hglasm::RangeScan>* scans) {
   } else {
     hglasm_odometry::BagReadOptions bag_options;
     bag_options.scan_topic = args.topic;
-    bag_options.odom_topic.clear();  // only the scans matter here
+    if (args.interlace_seconds == 0.0) bag_options.odom_topic.clear();  // only the scans matter here
     bag_options.max_scans = args.max_scans;
     hglasm_odometry::BagData data;
     if (!hglasm_odometry::readBag(args.bag, bag_options, &data, &error)) return failRuntime(error);
     std::cerr << "success_ratio: read " << data.scans.size() << " scans on " << args.topic << " from "
               << args.bag << "\n";
+    if (args.interlace_seconds != 0.0) {
+      if (data.odometry.size() < 2) return failRuntime("--interlace-seconds: the bag has no wheel odometry");
+      for (const hglasm_odometry::BagScan& scan : data.scans) {
+        half_offsets->push_back(hglasm::halfScanOffset(baseVelocityAt(data.odometry, scan.stamp),
+                                                       data.base_to_laser, args.interlace_seconds));
+      }
+      std::cerr << "success_ratio: truths offset by the laser's motion over " << args.interlace_seconds
+                << " s (wheel odometry, " << data.odometry.size() << " samples)\n";
+    }
     for (hglasm_odometry::BagScan& scan : data.scans) scans->push_back(std::move(scan.ranges));
   }
   if (scans->empty()) return failRuntime("no scans read");
@@ -292,12 +354,13 @@ std::string shellQuote(const std::string& text) {
   return quoted + "'";
 }
 
-std::string defaultCurveCsv(const std::string& csv) {
+// `csv` with `tail` (e.g. "_evaluations.csv") in place of its ".csv".
+std::string siblingCsv(const std::string& csv, const std::string& tail) {
   const std::string suffix = ".csv";
   if (csv.size() > suffix.size() && csv.compare(csv.size() - suffix.size(), suffix.size(), suffix) == 0) {
-    return csv.substr(0, csv.size() - suffix.size()) + "_evaluations.csv";
+    return csv.substr(0, csv.size() - suffix.size()) + tail;
   }
-  return csv + "_evaluations.csv";
+  return csv + tail;
 }
 
 bool writePlots(const hglasm::SuccessRatioReport& report, const Arguments& args) {
@@ -350,7 +413,7 @@ int main(int argc, char** argv) {
   }
 
   std::vector<hglasm::RangeScan> scans;
-  if (!readScans(args, &scans)) return kExitRuntimeError;
+  if (!readScans(args, &scans, &options.half_offsets)) return kExitRuntimeError;
 
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&start]() {
@@ -386,12 +449,17 @@ int main(int argc, char** argv) {
   }
   std::cerr << "success_ratio: wrote " << args.csv << "\n";
   if (!report.curve.empty()) {
-    const std::string curve_csv = args.curve_csv.empty() ? defaultCurveCsv(args.csv) : args.curve_csv;
-    if (!hglasm::writeEvaluationCurveCsv(curve_csv, report.curve, &error)) {
+    const std::string curve_csv =
+        args.curve_csv.empty() ? siblingCsv(args.csv, "_evaluations.csv") : args.curve_csv;
+    const std::string time_csv =
+        args.time_csv.empty() ? siblingCsv(args.csv, "_time_to_reach.csv") : args.time_csv;
+    const auto times = hglasm::timeToReach(report.curve, hglasm::timeToReachLevels());
+    if (!hglasm::writeEvaluationCurveCsv(curve_csv, report.curve, &error) ||
+        !hglasm::writeTimeToReachCsv(time_csv, times, &error)) {
       failRuntime(error);
       return kExitRuntimeError;
     }
-    std::cerr << "success_ratio: wrote " << curve_csv << "\n";
+    std::cerr << "success_ratio: wrote " << curve_csv << " and " << time_csv << "\n";
   }
   if (!args.plots.empty() && !writePlots(report, args)) return kExitRuntimeError;
   return 0;

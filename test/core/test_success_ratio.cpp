@@ -47,12 +47,14 @@ SuccessRatioReport run(const std::vector<RangeScan>& scans, const SuccessRatioOp
   return report;
 }
 
-/// CSV lines of the rows without the timing column (the only field that varies between runs).
+/// CSV lines of the rows without the timing column mean_ms (the only field that varies between runs).
 std::vector<std::string> linesWithoutTime(const SuccessRatioReport& report) {
   std::vector<std::string> lines;
   for (const SuccessRatioRow& row : report.rows) {
     const std::string line = successRatioCsvLine(row);
-    lines.push_back(line.substr(0, line.rfind(',')));
+    const std::size_t ceiling = line.rfind(',');
+    const std::size_t time = line.rfind(',', ceiling - 1);
+    lines.push_back(line.substr(0, time) + line.substr(ceiling));
   }
   return lines;
 }
@@ -212,7 +214,7 @@ TEST(SuccessRatio, RowsComeInAlgorithmPresetCaseOrderWithBoxLast) {
   }
   EXPECT_EQ(successRatioCsvHeader(),
             "algorithm,preset,rot_err_deg,trans_err_m,trials,successes,success_ratio,mean_dxy_m,mean_dth_deg,"
-            "mean_ms");
+            "mean_ms,ceiling");
 }
 
 TEST(SuccessRatio, SameSeedGivesTheSameRows) {
@@ -283,20 +285,23 @@ TEST(SuccessRatio, EvaluationCurvesCompareBothTablesAtEqualEvaluations) {
   options.curve_trials = 8;
   options.curve_generations = {1, 4, 8};
   options.presets = {Preset::kSmall, Preset::kMedium};
+  options.ceiling = false;
   std::vector<std::string> messages;
   SuccessRatioReport report;
   std::string error;
   ASSERT_TRUE(runSuccessRatio(roomScans(), options, &report, &error, [&](const SuccessRatioProgress& p) {
     messages.push_back(p.message);
     EXPECT_LE(p.cells_done, p.cells_total);
-    EXPECT_EQ(p.cells_total, 12u);
+    EXPECT_EQ(p.cells_total, 18u);
   })) << error;
   EXPECT_TRUE(report.rows.empty());
-  ASSERT_EQ(report.curve.size(), 2u * 2u * 3u);
-  EXPECT_EQ(messages.size(), 12u);
+  ASSERT_EQ(report.curve.size(), 2u * 3u * 3u);  // presets x (GLASM-g, binary GLASM, PGA) x generations
+  EXPECT_EQ(messages.size(), 18u);
+  EXPECT_EQ(report.curve[6].algorithm, Algorithm::kPga);
   for (std::size_t i = 0; i < report.curve.size(); i += 3) {
     const EvaluationCurvePoint* points = &report.curve[i];
-    EXPECT_TRUE(points[0].algorithm == Algorithm::kGlasmG || points[0].algorithm == Algorithm::kGlasmBinary);
+    EXPECT_TRUE(points[0].algorithm == Algorithm::kGlasmG || points[0].algorithm == Algorithm::kGlasmBinary ||
+                points[0].algorithm == Algorithm::kPga);
     for (int k = 0; k < 3; ++k) {
       EXPECT_EQ(points[k].generations, options.curve_generations[k]);
       EXPECT_EQ(points[k].trials, 8);
@@ -304,6 +309,11 @@ TEST(SuccessRatio, EvaluationCurvesCompareBothTablesAtEqualEvaluations) {
       if (k > 0) {
         EXPECT_GT(points[k].mean_evaluations, points[k - 1].mean_evaluations);
       }
+      // The search alone is part of the whole; medians are errors too.
+      EXPECT_GT(points[k].mean_search_ms, 0.0);
+      EXPECT_LE(points[k].mean_search_ms, points[k].mean_ms + 1e-9);
+      EXPECT_GE(points[k].median_dxy_m, 0.0);
+      EXPECT_GE(points[k].median_dth_deg, 0.0);
     }
   }
   // The generation count is applied: every new (non-elite) individual of every generation is evaluated
@@ -341,7 +351,7 @@ TEST(SuccessRatio, WritesCsvAndPlotScripts) {
   int rows = 0;
   while (std::getline(in, line)) {
     ++rows;
-    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 9) << line;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 10) << line;
   }
   EXPECT_EQ(rows, 5);
   EXPECT_TRUE(writeEvaluationCurveCsv(directory + "/success_ratio_test_curve.csv", report.curve, &error));
@@ -349,14 +359,119 @@ TEST(SuccessRatio, WritesCsvAndPlotScripts) {
 
   std::vector<std::string> scripts;
   ASSERT_TRUE(writeSuccessRatioPlotScripts(report, directory, "synthetic", &scripts, &error)) << error;
-  ASSERT_EQ(scripts.size(), 2u);  // one success-vs-rotation plot (mbicp, small), one evaluations plot
+  // One success-vs-rotation plot (mbicp, small), one evaluations plot, one time-to-reach chart.
+  ASSERT_EQ(scripts.size(), 3u);
   EXPECT_NE(scripts[0].find("success_mbicp_small.gp"), std::string::npos);
   EXPECT_NE(scripts[1].find("evaluations_small.gp"), std::string::npos);
+  EXPECT_NE(scripts[2].find("time_to_reach.gp"), std::string::npos);
   std::ifstream gp(scripts[0]);
   std::stringstream text;
   text << gp.rdbuf();
   EXPECT_NE(text.str().find("success_mbicp_small.png"), std::string::npos);
   EXPECT_NE(text.str().find("index 1"), std::string::npos);  // two translation errors: two curves
+}
+
+TEST(SuccessRatio, CeilingIsTheSuccessAtZeroErrorBesideEveryRow) {
+  SuccessRatioOptions options = baseOptions();
+  options.algorithms = {Algorithm::kMbicp, Algorithm::kGlasmBinary};
+  options.cases = {{20.0, 0.57}};
+  options.in_box = true;
+  options.trials = 10;
+  const SuccessRatioReport report = run(roomScans(), options);
+  ASSERT_EQ(report.rows.size(), 4u);
+  // The ceiling is the case 0:0 run on its own.
+  SuccessRatioOptions zero = options;
+  zero.cases = {{0.0, 0.0}};
+  zero.in_box = false;
+  zero.ceiling = false;
+  const SuccessRatioReport alone = run(roomScans(), zero);
+  ASSERT_EQ(alone.rows.size(), 2u);
+  for (const SuccessRatioRow& row : report.rows) {
+    const SuccessRatioRow& reference = row.algorithm == Algorithm::kMbicp ? alone.rows[0] : alone.rows[1];
+    EXPECT_EQ(row.ceiling_trials, 10);
+    EXPECT_EQ(row.ceiling_successes, reference.successes);
+    EXPECT_DOUBLE_EQ(row.ceiling, reference.success_ratio);
+    EXPECT_EQ(alone.rows[0].ceiling, -1.0);  // not run: empty CSV field
+  }
+  EXPECT_EQ(report.rows[0].ceiling, 1.0);  // MbICP from the truth on simulated scans
+  const std::string line = successRatioCsvLine(report.rows[0]);
+  EXPECT_EQ(line.substr(line.rfind(',') + 1), "1.0000");
+  const std::string empty = successRatioCsvLine(alone.rows[0]);
+  EXPECT_EQ(empty.back(), ',');
+  // The rows themselves do not depend on whether the ceiling ran.
+  SuccessRatioOptions without = options;
+  without.ceiling = false;
+  std::vector<std::string> with_lines = linesWithoutTime(report),
+                           without_lines = linesWithoutTime(run(roomScans(), without));
+  for (std::string& l : with_lines) l = l.substr(0, l.rfind(','));  // drop the ceiling
+  for (std::string& l : without_lines) l = l.substr(0, l.rfind(','));
+
+  EXPECT_EQ(with_lines, without_lines);
+}
+
+TEST(SuccessRatio, HalfScanOffsetsMoveTheTruth) {
+  // A half-scan offset of 0.02 rad (beyond the 0.01 rad threshold): matched from the identity, the
+  // simulated halves (one instant) come out at the identity, which is now 0.02 rad from the truth.
+  SuccessRatioOptions options = baseOptions();
+  options.cases = {{0.0, 0.0}};
+  options.ceiling = false;
+  const std::vector<RangeScan> scans = roomScans();
+  options.half_offsets.assign(scans.size(), Pose2D(0.0, 0.0, 0.02));
+  const SuccessRatioReport moved = run(scans, options);
+  EXPECT_EQ(moved.rows.at(0).successes, 0);
+  EXPECT_NEAR(moved.rows[0].mean_dth_deg, 0.02 * 180.0 / M_PI, 0.05);
+  options.half_offsets.assign(scans.size(), Pose2D());
+  EXPECT_EQ(run(scans, options).rows.at(0).successes, 20);
+  options.half_offsets.resize(1);
+  SuccessRatioReport report;
+  std::string error;
+  EXPECT_FALSE(runSuccessRatio(scans, options, &report, &error));
+}
+
+TEST(SuccessRatio, HalfScanOffsetIsTheInverseOfTheLasersMotion) {
+  // Turning at 1 rad/s, odd beams 14 ms after even ones: the even half is rotated by -0.014 rad.
+  const Pose2D offset = halfScanOffset(Eigen::Vector3d(0.0, 0.0, 1.0), Pose2D(), 0.014);
+  EXPECT_NEAR(offset.theta, -0.014, 1e-12);
+  EXPECT_NEAR(offset.x, 0.0, 1e-12);
+  // Driving forward at 0.5 m/s: the even half's sensor is 7 mm behind.
+  const Pose2D forward = halfScanOffset(Eigen::Vector3d(0.5, 0.0, 0.0), Pose2D(), 0.014);
+  EXPECT_NEAR(forward.x, -0.007, 1e-12);
+  EXPECT_NEAR(forward.theta, 0.0, 1e-12);
+  // A laser 0.04 m ahead of the base, turning on the spot: it also moves sideways (0.04 * 0.014 m).
+  const Pose2D mounted = halfScanOffset(Eigen::Vector3d(0.0, 0.0, 1.0), Pose2D(0.04, 0.0, 0.0), 0.014);
+  EXPECT_NEAR(mounted.theta, -0.014, 1e-12);
+  EXPECT_NEAR(std::hypot(mounted.x, mounted.y), 0.04 * 2.0 * std::sin(0.007), 1e-9);
+}
+
+TEST(SuccessRatio, TimeToReachTakesTheFewestGenerationsThatReachTheLevel) {
+  std::vector<EvaluationCurvePoint> curve;
+  const double ratios[] = {0.40, 0.75, 0.72, 0.93};
+  const int generations[] = {1, 2, 4, 8};
+  for (int i = 0; i < 4; ++i) {
+    EvaluationCurvePoint point;
+    point.algorithm = Algorithm::kPga;
+    point.preset = Preset::kLarge;
+    point.generations = generations[i];
+    point.success_ratio = ratios[i];
+    point.mean_evaluations = 100.0 * generations[i];
+    point.mean_search_ms = 1.0 * generations[i];
+    point.mean_ms = 1.0 * generations[i] + 0.5;
+    curve.push_back(point);
+  }
+  const std::vector<TimeToReach> entries = timeToReach(curve, {0.5, 0.7, 0.9, 0.95});
+  ASSERT_EQ(entries.size(), 4u);
+  EXPECT_TRUE(entries[0].reached);
+  EXPECT_EQ(entries[0].generations, 2);  // 0.75 at 2 generations
+  EXPECT_EQ(entries[1].generations, 2);
+  EXPECT_DOUBLE_EQ(entries[1].search_ms, 2.0);
+  EXPECT_DOUBLE_EQ(entries[1].total_ms, 2.5);
+  EXPECT_EQ(entries[2].generations, 8);
+  EXPECT_DOUBLE_EQ(entries[2].success_ratio, 0.93);
+  EXPECT_FALSE(entries[3].reached);
+  EXPECT_EQ(timeToReachCsvLine(entries[3]), "pga,large,0.95,0,,,,,");
+  EXPECT_EQ(timeToReachCsvLine(entries[2]), "pga,large,0.90,1,8,800.0,0.9300,8.0000,8.5000");
+  const std::string header = timeToReachCsvHeader();
+  EXPECT_EQ(std::count(header.begin(), header.end(), ','), 8);
 }
 
 }  // namespace

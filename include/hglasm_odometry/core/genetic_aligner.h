@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -60,6 +61,18 @@ struct PreAlignResult {
   int evaluations = 0;         ///< fitness evaluations: 1 (guess) + population * generations * runs + polish
 };
 
+/// Scores a candidate pose of the new scan in the reference frame (higher is better).
+using PoseFitness = std::function<std::uint32_t(const Pose2D&)>;
+
+/// What one alignment maximises: the GA engine is the same whatever scores the poses (GLASM's lookup
+/// tables, PGA's polar pairing), so comparisons at equal evaluations compare the fitness alone.
+struct FitnessStages {
+  PoseFitness fine;           ///< scores every pose after the coarse generations, and the guess
+  PoseFitness coarse;         ///< the first coarse_generations generations (empty: none)
+  double polish_step = 0.04;  ///< metres: the compass search's finest translation step
+  double max_fitness = 0.0;   ///< fitness of a perfect fit (for fitness_ratio); 0: ratio 0
+};
+
 /// Not thread-safe per instance (it owns its random generator); separate instances are independent.
 class GeneticAligner {
  public:
@@ -73,14 +86,21 @@ class GeneticAligner {
                        const Pose2D& guess, std::vector<Pose2D>* population_out = nullptr,
                        const LookupTable* coarse_table = nullptr, const SearchEffort* effort = nullptr);
 
+  /// The same GA over any fitness (see FitnessStages); the guess competes and the polish runs on `fine`.
+  PreAlignResult align(const FitnessStages& stages, const Pose2D& guess,
+                       std::vector<Pose2D>* population_out = nullptr, const SearchEffort* effort = nullptr);
+
+  /// The points the fitness uses: all of them, or max_points evenly spread over the scan.
+  const std::vector<Eigen::Vector2d>& fitnessSubset(const std::vector<Eigen::Vector2d>& all_points);
+
   /// Restarts the random sequence (same seed -> same results).
   void reseed(std::uint64_t seed) { rng_.seed(seed); }
 
   const GeneticOptions& options() const { return options_; }
 
  private:
-  void polish(const LookupTable& table, const FitnessPoints& points, const Pose2D& guess,
-              const SearchBox& box, PreAlignResult* result) const;
+  void polish(const PoseFitness& fitness, double finest_step, const Pose2D& guess, const SearchBox& box,
+              PreAlignResult* result) const;
 
   GeneticOptions options_;
   std::mt19937_64 rng_;

@@ -9,6 +9,7 @@
 #include "hglasm_odometry/core/genetic_aligner.h"
 #include "hglasm_odometry/core/lookup_table.h"
 #include "hglasm_odometry/core/mbicp.h"
+#include "hglasm_odometry/core/polar_pairing.h"
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
 
@@ -21,12 +22,16 @@ enum class Algorithm {
   kGlasmG,        ///< graded-table GA alone
   kGlasmBinary,   ///< binary-table GA alone
   kMbicp,         ///< MbICP alone from the guess
+  kPga,           ///< PGA (Martinez et al. 2006): the same GA on polar pairing, no lookup table, alone
+  kHpga,          ///< PGA, then MbICP (the hybrid GA-ICP, with this matcher's MbICP)
 };
 const char* toString(Algorithm algorithm);
-/// Parses "hglasm_g", "hglasm_binary", "glasm_g", "glasm_binary", "mbicp". False if unknown.
+/// Parses "hglasm_g", "hglasm_binary", "glasm_g", "glasm_binary", "mbicp", "pga", "hpga". False if unknown.
 bool parseAlgorithm(const std::string& name, Algorithm* algorithm);
 bool usesGeneticStage(Algorithm algorithm);
 bool usesMbicpStage(Algorithm algorithm);
+/// PGA and HPGA: the GA scores poses by polar pairing instead of a lookup table.
+bool usesPolarPairing(Algorithm algorithm);
 
 /// Search-space presets of the papers' Table 1.
 enum class Preset { kSmall, kMedium, kLarge };
@@ -40,6 +45,7 @@ struct MatcherOptions {
   LookupTableOptions coarse_table{TableKind::kGraded, 0.06, 0.30, 0.60, 0.30, 0.10};
   GeneticOptions genetic;
   MbicpOptions mbicp;
+  PolarPairingOptions pga;  ///< PGA / HPGA only
 };
 
 /// Built-in defaults of each preset (config/presets.yaml holds the same values for ROS users).
@@ -88,6 +94,8 @@ class ScanMatcher {
   void setReference(const ReferencePoints& reference);
   bool hasReference() const { return has_reference_; }
   double lastTableBuildMs() const { return table_build_ms_; }
+  /// Time the last match() spent building the coarse table (built on first use; 0 if it did not).
+  double lastCoarseTableBuildMs() const { return coarse_table_build_ms_; }
 
   /// Matches `scan` (points in its own frame) against the reference, starting from `guess`. `effort`
   /// (optional) replaces the preset's box and GA size; `prior` (optional) makes MbICP's result the
@@ -115,12 +123,15 @@ class ScanMatcher {
   LookupTable coarse_table_;
   GeneticAligner aligner_;
   Mbicp mbicp_;
+  PolarPairing polar_pairing_;  // PGA's "table": the reference sorted into angular steps
+  FitnessPoints pga_points_;    // scratch: the new scan's points for PGA's fitness
   /// Fills the defaults of a result (the guess, a large covariance); false if there is nothing to match.
   bool startResult(const Scan& scan, const Pose2D& guess, MatchResult* result) const;
   void refineInto(const Scan& scan, const PosePrior* prior, MatchResult* result);
 
   bool has_reference_ = false;
   double table_build_ms_ = 0.0;
+  double coarse_table_build_ms_ = 0.0;
   // The coarse table is built on first use: searches sized by a tight prior never need it.
   ReferencePoints reference_;
   bool coarse_table_stale_ = false;

@@ -8,6 +8,7 @@
 // the same pairs, and a case gives the same trials whatever other cases run alongside it.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -60,7 +61,19 @@ struct SuccessRatioOptions {
   /// Generation counts for the curves; empty = 1, 2, 3, 4, 6, 8, 10, 12, 16, 20, 24 up to twice the
   /// preset's own generation count.
   std::vector<int> curve_generations;
+  /// The GA-alone algorithms of the curves (kGlasmG, kGlasmBinary, kPga).
+  std::vector<Algorithm> curve_algorithms{Algorithm::kGlasmG, Algorithm::kGlasmBinary, Algorithm::kPga};
+  /// Per (algorithm, preset): the success ratio at zero initial error (the halves matched from the
+  /// identity), `trials` trials of the case 0:0, reported beside every row as its ceiling.
+  bool ceiling = true;
+  /// Per scan (empty, or one per input scan): the pose of the even half's sensor in the odd half's frame
+  /// when the halves were not recorded at the same instant (interlaced sweeps, see halfScanOffset). The
+  /// truth of a trial is then offset * IPE.
+  std::vector<Pose2D> half_offsets;
 };
+
+/// Success-ratio levels of the time-to-reach table (the papers' Figure 6).
+std::vector<double> timeToReachLevels();
 
 /// One CSV row: one (algorithm, preset, case).
 struct SuccessRatioRow {
@@ -76,11 +89,15 @@ struct SuccessRatioRow {
   double mean_ms = 0.0;           ///< wall time of setReference() + match(): the table build is included
   int failed_status = 0;          ///< trials whose matcher status was a failure (never a success)
   double mean_evaluations = 0.0;  ///< GA fitness evaluations per match
+  /// Success ratio of the same (algorithm, preset) at zero initial error (options.ceiling); -1 if not run.
+  double ceiling = -1.0;
+  int ceiling_successes = 0;
+  int ceiling_trials = 0;
 };
 
 /// One point of the pre-alignment-vs-evaluations curves.
 struct EvaluationCurvePoint {
-  Algorithm algorithm = Algorithm::kGlasmG;  ///< kGlasmG or kGlasmBinary
+  Algorithm algorithm = Algorithm::kGlasmG;  ///< kGlasmG, kGlasmBinary or kPga
   Preset preset = Preset::kSmall;
   int population = 0;
   int generations = 0;
@@ -92,7 +109,30 @@ struct EvaluationCurvePoint {
   double mean_dxy_m = 0.0;
   double mean_dth_deg = 0.0;
   double mean_ms = 0.0;  ///< table build included
+  double median_dxy_m = 0.0;
+  double median_dth_deg = 0.0;
+  /// Time of the search alone: mean_ms less the reference's preparation (lookup tables, coarse table
+  /// included; PGA: sorting the reference into angular steps), as the papers time it.
+  double mean_search_ms = 0.0;
 };
+
+/// Figure 6: the time one GA-alone algorithm needs to reach a success ratio: the curve's point with the
+/// fewest generations whose success ratio reaches the level (the curves are measured, not fitted).
+struct TimeToReach {
+  Algorithm algorithm = Algorithm::kGlasmG;
+  Preset preset = Preset::kSmall;
+  double level = 0.0;  ///< success ratio, 0..1
+  bool reached = false;
+  int generations = 0;
+  double evaluations = 0.0;
+  double success_ratio = 0.0;  ///< of that point (>= level)
+  double search_ms = 0.0;      ///< preparation excluded (the papers' timing)
+  double total_ms = 0.0;       ///< preparation included
+};
+
+/// One TimeToReach per (preset, algorithm, level) of the curves, in the curves' order.
+std::vector<TimeToReach> timeToReach(const std::vector<EvaluationCurvePoint>& curve,
+                                     const std::vector<double>& levels);
 
 struct SuccessRatioReport {
   std::vector<SuccessRatioRow> rows;        ///< by algorithm, preset (option order), then case, box last
@@ -122,23 +162,36 @@ Pose2D caseTrialError(const IpeCase& ipe, std::uint64_t seed, int trial, std::si
 Pose2D boxTrialError(const SearchBox& box, std::uint64_t seed, int trial, std::size_t scan_count,
                      std::size_t* scan_index);
 
-/// `algorithm,preset,rot_err_deg,trans_err_m,trials,successes,success_ratio,mean_dxy_m,mean_dth_deg,mean_ms`
+/// The pose of the even half's sensor in the odd half's frame for a scan whose odd beams are recorded
+/// `seconds` after its even ones (interlaced sweeps), the base moving at `base_velocity` (vx, vy in m/s,
+/// omega in rad/s, base frame) and the laser mounted at `base_to_laser`: the inverse of the laser's
+/// motion over `seconds` (first order: a rotation of -omega * seconds and the matching translation).
+Pose2D halfScanOffset(const Eigen::Vector3d& base_velocity, const Pose2D& base_to_laser, double seconds);
+
+/// `algorithm,preset,rot_err_deg,trans_err_m,trials,successes,success_ratio,mean_dxy_m,mean_dth_deg,mean_ms,
+/// ceiling` (ceiling empty when not run)
 std::string successRatioCsvHeader();
 std::string successRatioCsvLine(const SuccessRatioRow& row);
 std::string evaluationCurveCsvHeader();
 std::string evaluationCurveCsvLine(const EvaluationCurvePoint& point);
+std::string timeToReachCsvHeader();
+std::string timeToReachCsvLine(const TimeToReach& entry);
 
 /// Writes header + rows. False (with *error) if the file cannot be written.
 bool writeSuccessRatioCsv(const std::string& path, const std::vector<SuccessRatioRow>& rows,
                           std::string* error);
 bool writeEvaluationCurveCsv(const std::string& path, const std::vector<EvaluationCurvePoint>& curve,
                              std::string* error);
+bool writeTimeToReachCsv(const std::string& path, const std::vector<TimeToReach>& entries,
+                         std::string* error);
 
 /// Writes gnuplot data files and scripts into `directory` (which must exist): one success-vs-rotation
 /// plot per (algorithm, preset) with one curve per translation error (the papers' Figures 7/8), when
 /// the report has at least two rotation errors; one pre-alignment-vs-evaluations plot per preset
-/// (Figures 5/6), when it has curve points. `scripts` receives the .gp paths; each writes a PNG next to
-/// it when run with gnuplot. `title` prefixes every plot title (e.g. the dataset name).
+/// (Figure 5: success, mean and median errors of GLASM-g, binary GLASM and PGA), when it has curve points;
+/// one time-to-reach bar chart (Figure 6, small and large presets, preparation excluded and included).
+/// `scripts` receives the .gp paths; each writes a PNG next to it when run with gnuplot. `title` prefixes
+/// every plot title (e.g. the dataset name).
 bool writeSuccessRatioPlotScripts(const SuccessRatioReport& report, const std::string& directory,
                                   const std::string& title, std::vector<std::string>* scripts,
                                   std::string* error);
