@@ -138,8 +138,9 @@ summary() {
     echo "== $log: 20 deg + 0.57 m and in-box (errors uniform in the preset's box), $headline_trials trials per cell"
     interlace="$dir/ceiling_interlace.csv"
     [[ -f "$interlace" && "$log" == fr079 ]] || interlace=/dev/null
-    awk -F, 'FNR == 1 { file++; next }
-      file == 1 { ceiling_interlace[$1 " " $2] = sprintf("%5.1f%%", 100 * $7); next }
+    # The interlace file is told apart by name: /dev/null has no header line to count files by.
+    awk -F, -v interlace_file="$interlace" 'FNR == 1 { next }
+      FILENAME == interlace_file { ceiling_interlace[$1 " " $2] = sprintf("%5.1f%%", 100 * $7); next }
       {
         key = $1 " " $2; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
         cell = ($3 == "box") ? "box" : "head"
