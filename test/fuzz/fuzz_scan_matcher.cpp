@@ -54,7 +54,8 @@ void checkFinite(const hglasm::MatchResult& result) {
   check(result.pose.isFinite());
   check(result.prealigned_pose.isFinite());
   check(result.covariance.allFinite());
-  check(std::isfinite(result.fitness_ratio) && result.fitness_ratio >= 0.0 && result.fitness_ratio <= 1.0 + 1e-9);
+  check(std::isfinite(result.fitness_ratio) && result.fitness_ratio >= 0.0 &&
+        result.fitness_ratio <= 1.0 + 1e-9);
 }
 
 }  // namespace
@@ -64,7 +65,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint8_t selector = reader.take<std::uint8_t>();
   const hglasm::Preset preset = static_cast<hglasm::Preset>(selector % 3);
   hglasm::MatcherOptions options = hglasm::presetOptions(preset);
-  options.algorithm = static_cast<hglasm::Algorithm>((selector / 3) % 5);
+  options.algorithm = static_cast<hglasm::Algorithm>((selector / 3) % 7);  // PGA and HPGA included
   // Keep each run short: the fuzzer explores inputs, not GA sizes.
   options.genetic.population = 10;
   options.genetic.generations = 3;
