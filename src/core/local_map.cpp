@@ -36,12 +36,20 @@ void LocalMap::rebuild() {
   // robot moves through it instead of following the newest keyframe's error.
   for (const Keyframe& keyframe : keyframes_) {
     const Pose2D pose = to_frame * keyframe.laser_pose;
-    kept_.clear();
     // A keyframe is never thinned by its own points (its beams keep their spacing), only by other keyframes'.
     const std::size_t first = reference_.size();
-    for (const auto& point : keyframe.points) {
-      if (options_.resolution > 0.0 && covered(pose * point)) continue;
-      kept_.push_back(point);
+    const std::vector<Eigen::Vector2d>& points = keyframe.points;
+    covered_.assign(points.size(), 0);
+    if (options_.resolution > 0.0) {
+      for (std::size_t i = 0; i < points.size(); ++i) covered_[i] = covered(pose * points[i]);
+    }
+    // A kept point keeps its neighbouring beams too, covered or not: the surface it lies on stays a surface
+    // (alone, a thinned wall's survivors would be isolated points, precise along their beams, which along
+    // a corridor's wall is the direction nothing observes).
+    kept_.clear();
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const bool neighbour_kept = (i > 0 && !covered_[i - 1]) || (i + 1 < points.size() && !covered_[i + 1]);
+      if (!covered_[i] || neighbour_kept) kept_.push_back(points[i]);
     }
     reference_.append(kept_, pose);
     if (options_.resolution > 0.0) {

@@ -52,9 +52,33 @@ void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
   build(single);
 }
 
+void LookupTable::stampFootprints(const ReferencePoints& reference, const std::vector<std::uint8_t>& joins,
+                                  double spacing) {
+  for (std::size_t scan = 0; scan < reference.scan_starts.size(); ++scan) {
+    const std::size_t begin = reference.scan_starts[scan], end = reference.scanEnd(scan);
+    const Eigen::Vector2d origin = reference.scanOrigin(scan);
+    const double step = angularStep(reference, scan);
+    for (std::size_t i = begin; i < end; ++i) {
+      const Eigen::Vector2d& p = reference.points[i];
+      const bool isolated = !(i > begin && joins[i - 1]) && !joins[i];
+      if (!isolated || !withinTable(p)) continue;
+      const Eigen::Vector2d beam = p - origin;
+      // Capped: a scan of a few points has no meaningful angular step.
+      const double half_width =
+          std::min(0.5 * options_.isolated_footprint * step * beam.norm(), kMaxFootprint);
+      if (!(half_width > spacing) || !(beam.norm() > 0.0)) continue;
+      const Eigen::Vector2d across = Eigen::Vector2d(-beam.y(), beam.x()).normalized();
+      const int pieces = static_cast<int>(std::ceil(half_width / spacing));
+      for (int k = 1; k <= pieces; ++k) {
+        samples_.push_back(p + across * (half_width * k / pieces));
+        samples_.push_back(p - across * (half_width * k / pieces));
+      }
+    }
+  }
+}
+
 void LookupTable::build(const ReferencePoints& reference_set) {
   const std::vector<Eigen::Vector2d>& reference = reference_set.points;
-  const std::vector<std::uint8_t> same_scan_as_next = reference_set.sameScanAsNext();
   tiles_in_use_ = 0;
   tiles_x_ = tiles_y_ = 0;
   tile_index_.clear();
@@ -67,29 +91,21 @@ void LookupTable::build(const ReferencePoints& reference_set) {
   // every point of the segment is within a quarter sigma of a sample.
   samples_.clear();
   const double spacing = std::max(options_.cell_size, 0.5 * options_.sigma);
-  const Eigen::Vector2d* previous = nullptr;
+  const std::vector<std::uint8_t> joins = joinSurfaces(reference_set, options_.surface());
   for (std::size_t i = 0; i < reference.size(); ++i) {
     const Eigen::Vector2d& p = reference[i];
-    if (i > 0 && !same_scan_as_next[i - 1]) previous = nullptr;  // never join two scans
     // Points beyond kMaxCoordinate get no cell (below); they must not be joined either: the joining gap
     // grows with the range, and two wild readings 1e30 m out would be joined by billions of samples.
-    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || std::abs(p.x()) > kMaxCoordinate ||
-        std::abs(p.y()) > kMaxCoordinate) {
-      continue;
-    }
-    if (previous && options_.segment_max_gap > 0.0) {
-      const double range = std::min(previous->norm(), p.norm());
-      const double max_gap = options_.segment_max_gap + options_.segment_gap_per_metre * range;
-      const double gap = (p - *previous).norm();
-      if (gap < max_gap && gap > spacing) {
-        const int pieces = static_cast<int>(std::ceil(gap / spacing));
-        for (int k = 1; k < pieces; ++k)
-          samples_.push_back(*previous + (p - *previous) * (double(k) / pieces));
-      }
-    }
+    if (!withinTable(p)) continue;
     samples_.push_back(p);
-    previous = &p;
+    if (i + 1 < reference.size() && joins[i] && withinTable(reference[i + 1])) {
+      const Eigen::Vector2d& next = reference[i + 1];
+      const double gap = (next - p).norm();
+      const int pieces = static_cast<int>(std::ceil(gap / spacing));
+      for (int k = 1; k < pieces; ++k) samples_.push_back(p + (next - p) * (double(k) / pieces));
+    }
   }
+  if (options_.isolated_footprint > 0.0) stampFootprints(reference_set, joins, spacing);
   for (const auto& p : samples_) {
     if (std::abs(p.x()) > kMaxCoordinate || std::abs(p.y()) > kMaxCoordinate) continue;
     const long cx = static_cast<long>(std::floor(p.x() * inv_cell_size_));

@@ -70,28 +70,26 @@ void Mbicp::setReference(const Scan& reference) {
 
 void Mbicp::setReference(const ReferencePoints& reference) {
   ref_points_.clear();
-  // Which scan each kept point came from: segments never join two scans.
-  std::vector<std::size_t> scan_of_point;
+  // The finite points, each with its index in `reference` and the scan it came from.
+  std::vector<std::size_t> kept_index, scan_of_point;
   const std::vector<std::uint8_t> same_scan_as_next = reference.sameScanAsNext();
   std::size_t scan = 0;
   for (std::size_t i = 0; i < reference.size(); ++i) {
     if (reference.points[i].allFinite()) {
       ref_points_.push_back(reference.points[i]);
+      kept_index.push_back(i);
       scan_of_point.push_back(scan);
     }
     if (!same_scan_as_next[i]) ++scan;
   }
-  std::vector<std::uint8_t> same_scan(ref_points_.size(), 0);
-  for (std::size_t i = 0; i + 1 < ref_points_.size(); ++i)
-    same_scan[i] = scan_of_point[i] == scan_of_point[i + 1];
   const std::size_t n = ref_points_.size();
+  // Segments join neighbouring beams of one surface (never two scans, never across a missing beam).
+  const std::vector<std::uint8_t> joins =
+      joinSurfaces(reference, SurfaceOptions{options_.segment_max_gap, options_.segment_max_incidence});
   ref_has_next_.assign(n, 0);
-  for (std::size_t i = 0; i + 1 < n; ++i) {
-    if (!same_scan[i]) continue;
-    const double range = std::min(ref_points_[i].norm(), ref_points_[i + 1].norm());
-    const double max_gap = options_.segment_max_gap + options_.segment_gap_per_metre * range;
-    ref_has_next_[i] = (ref_points_[i + 1] - ref_points_[i]).squaredNorm() < max_gap * max_gap ? 1 : 0;
-  }
+  for (std::size_t i = 0; i + 1 < n; ++i)
+    ref_has_next_[i] = kept_index[i + 1] == kept_index[i] + 1 && joins[kept_index[i]];
+  computeSamplingUncertainty(reference, scan_of_point);
   ref_normals_.assign(n, Eigen::Vector2d::Zero());
   for (std::size_t i = 0; i < n; ++i) {
     const bool has_prev = i > 0 && ref_has_next_[i - 1];
@@ -112,6 +110,24 @@ void Mbicp::setReference(const ReferencePoints& reference) {
             [&](int a, int b) { return bearing[a] < bearing[b]; });
   sorted_bearing_.resize(n);
   for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
+}
+
+void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
+                                       const std::vector<std::size_t>& scan_of_point) {
+  const std::size_t n = ref_points_.size();
+  ref_tangents_.assign(n, Eigen::Vector2d::Zero());
+  ref_sampling_variance_.assign(n, 0.0);
+  std::vector<double> step(reference.scan_starts.size());
+  for (std::size_t scan = 0; scan < step.size(); ++scan) step[scan] = angularStep(reference, scan);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t scan = scan_of_point[i];
+    const Eigen::Vector2d beam = ref_points_[i] - reference.scanOrigin(scan);
+    const double range = beam.norm();
+    if (!(range > 0.0) || scan >= step.size()) continue;
+    ref_tangents_[i] = Eigen::Vector2d(-beam.y(), beam.x()) / range;
+    // The surface the beam hit lies anywhere in the beam's angular cell: uniform over range * step.
+    ref_sampling_variance_[i] = range * step[scan] * range * step[scan] / 12.0;
+  }
 }
 
 void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
@@ -137,6 +153,9 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
         association.target = ref_points_[j];
         association.normal = ref_normals_[j];
         association.on_segment = false;
+        const bool isolated = ref_normals_[j].isZero();
+        association.sampling_tangent = isolated ? ref_tangents_[j] : Eigen::Vector2d::Zero();
+        association.sampling_variance = isolated ? ref_sampling_variance_[j] : 0.0;
       }
     };
     auto consider_segment = [&](int j) {
@@ -155,6 +174,8 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
         association.target = on_segment;
         association.normal = unitNormal(e);
         association.on_segment = true;
+        association.sampling_tangent = Eigen::Vector2d::Zero();
+        association.sampling_variance = 0.0;
       }
     };
 
@@ -207,6 +228,7 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
     if (found) {
       association.point = p;
       association.distance_sq = std::max(0.0, best);
+      association.weight = 1.0;
       out->push_back(association);
     }
   }
@@ -307,14 +329,25 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial, const PosePrio
   return result;
 }
 
-double Mbicp::informationScale(std::size_t constraints) const {
-  if (!(options_.independent_points > 0.0) || constraints == 0) return 1.0;
-  return std::min(1.0, options_.independent_points / static_cast<double>(constraints));
+double Mbicp::informationScale(double constraints) const {
+  if (!(options_.independent_points > 0.0) || !(constraints > 0.0)) return 1.0;
+  return std::min(1.0, options_.independent_points / constraints);
+}
+
+double Mbicp::robustScaleSq() const {
+  if (!(options_.robust_scale > 0.0) || associations_.empty()) return 0.0;
+  std::vector<double> distance_sq(associations_.size());
+  for (std::size_t i = 0; i < distance_sq.size(); ++i) distance_sq[i] = associations_[i].distance_sq;
+  auto median = distance_sq.begin() + distance_sq.size() / 2;
+  std::nth_element(distance_sq.begin(), median, distance_sq.end());
+  const double noise_sq = options_.point_noise * options_.point_noise;
+  return options_.robust_scale * options_.robust_scale * std::max({*median, noise_sq, kNoiseFloor});
 }
 
 bool Mbicp::solveStep(const Pose2D& pose, bool settled, std::size_t min_associations, const PosePrior* prior,
                       Eigen::Vector3d* step, Eigen::Vector3d* scan_only_step, double* error) {
-  // Trimming: the worst associations (outliers, unmatched structure) do not vote.
+  // Trimming: the worst associations (moved objects, unmatched structure) do not vote; robust weights make
+  // the rest fade smoothly with their distance.
   const std::size_t keep = std::max(
       min_associations, static_cast<std::size_t>(std::ceil(options_.trim_fraction * associations_.size())));
   if (keep < associations_.size()) {
@@ -323,14 +356,14 @@ bool Mbicp::solveStep(const Pose2D& pose, bool settled, std::size_t min_associat
         [](const Association& a, const Association& b) { return a.distance_sq < b.distance_sq; });
     associations_.resize(keep);
   }
-
+  const double robust_scale_sq = robustScaleSq();
   // Closed-form step: minimise sum (r + J q)^T M (r + J q) over the increment q = (x, y, theta), with
   // the point moved by the linearised rotation (J = [1 0 -p_y; 0 1 p_x]) and M the d_ap metric at the target.
   const double l_sq = options_.metric_l * options_.metric_l;
   Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
-  double error_sum = 0.0, residual_sq = 0.0;
-  for (const auto& assoc : associations_) {
+  double error_sum = 0.0, residual_sq = 0.0, weight_sum = 0.0;
+  for (auto& assoc : associations_) {
     const Eigen::Vector2d& p = assoc.point;
     const Eigen::Vector2d& c = assoc.target;
     const Eigen::Vector2d u(c.y(), -c.x());
@@ -340,25 +373,37 @@ bool Mbicp::solveStep(const Pose2D& pose, bool settled, std::size_t min_associat
     // pull it towards the last reference beam: a rotation bias at every edge).
     const bool line_residual =
         options_.point_to_line && (assoc.on_segment || (settled && !assoc.normal.isZero()));
+    double residual_sq_one = assoc.distance_sq;
     if (line_residual) {
       // Distance to the line under the metric: remove the metric-weighted tangent direction.
       const Eigen::Vector2d tangent(assoc.normal.y(), -assoc.normal.x());
       const Eigen::Vector2d m_tangent = m * tangent;
       m -= m_tangent * m_tangent.transpose() / tangent.dot(m_tangent);
       const double r = assoc.normal.dot(p - c);
-      residual_sq += r * r;
-    } else {
-      residual_sq += assoc.distance_sq;
+      residual_sq_one = r * r;
+    } else if (options_.point_noise > 0.0 && assoc.sampling_variance > 0.0) {
+      // Isolated reference point: across its beam the residual is mostly the sampling's, not the pose's.
+      const double noise_sq = options_.point_noise * options_.point_noise;
+      const double keep = noise_sq / (noise_sq + assoc.sampling_variance);
+      const Eigen::Vector2d m_tangent = m * assoc.sampling_tangent;
+      m -= (1.0 - keep) * m_tangent * m_tangent.transpose() / assoc.sampling_tangent.dot(m_tangent);
+      const Eigen::Vector2d d = p - c;
+      residual_sq_one = d.dot(m * d);
     }
+    assoc.weight = robust_scale_sq > 0.0 ? 1.0 / (1.0 + assoc.distance_sq / robust_scale_sq) : 1.0;
+    m *= assoc.weight;
+    residual_sq += assoc.weight * residual_sq_one;
+    weight_sum += assoc.weight;
+    error_sum += assoc.weight * assoc.distance_sq;
     Eigen::Matrix<double, 2, 3> jacobian;
     jacobian << 1.0, 0.0, -p.y(), 0.0, 1.0, p.x();
     const Eigen::Matrix<double, 3, 2> jt_m = jacobian.transpose() * m;
     a += jt_m * jacobian;
     b += jt_m * (p - c);
-    error_sum += assoc.distance_sq;
   }
-  const std::size_t count = associations_.size();
-  *error = error_sum / static_cast<double>(count);
+  // The weights' sum is the number of associations that count (all of them without robust weights).
+  const double count = weight_sum;
+  *error = error_sum / std::max(count, kNoiseFloor);
   // A whisker of damping keeps directions nothing constrains (a straight wall) at zero step.
   const auto damped = [](Eigen::Matrix3d m) {
     m.diagonal() += Eigen::Vector3d::Constant(1e-9 * m.trace() + 1e-12);
@@ -366,8 +411,7 @@ bool Mbicp::solveStep(const Pose2D& pose, bool settled, std::size_t min_associat
   };
   *scan_only_step = damped(a).ldlt().solve(-b);
   // The scan's information: the same normal equations in units of the residuals' (calibrated) noise.
-  const double variance =
-      std::max(residual_sq / std::max<double>(1.0, static_cast<double>(count) - 3.0), kNoiseFloor);
+  const double variance = std::max(residual_sq / std::max(1.0, count - 3.0), kNoiseFloor);
   scan_information_ = a * (informationScale(count) / variance);
   if (prior) {
     // MAP step: the scan's information plus the prior on the pose. The pose moves by G q for an increment
@@ -389,19 +433,20 @@ void Mbicp::estimateUncertainty(const PosePrior* prior, MbicpResult* result) con
   // Uncertainty from point-to-line information: only the component of each residual along the reference
   // normal is informative (a point may slide along a wall), so a corridor shows its unconstrained axis.
   Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
-  double residual_sq = 0.0;
-  int constraints = 0;
+  double residual_sq = 0.0, constraints = 0.0;
+  int surface_points = 0;
   for (const auto& assoc : associations_) {
     if (assoc.normal.isZero()) continue;
     const Eigen::Vector2d& p = assoc.point;  // in the reference frame, as the increments are
     const Eigen::Vector3d row(assoc.normal.x(), assoc.normal.y(),
                               assoc.normal.y() * p.x() - assoc.normal.x() * p.y());
-    information += row * row.transpose();
+    information += assoc.weight * row * row.transpose();
     const double r = assoc.normal.dot(assoc.point - assoc.target);
-    residual_sq += r * r;
-    ++constraints;
+    residual_sq += assoc.weight * r * r;
+    constraints += assoc.weight;
+    ++surface_points;
   }
-  if (constraints <= 3) {
+  if (surface_points <= 3 || !(constraints > 3.0)) {
     if (!prior) {
       result->status = MbicpStatus::kTooFewAssociations;
       return;

@@ -67,6 +67,7 @@ Scan scanFromRanges(const RangeScan& input, const ScanConversionOptions& options
 void ReferencePoints::append(const std::vector<Eigen::Vector2d>& scan_points, const Pose2D& pose) {
   if (scan_points.empty()) return;
   scan_starts.push_back(points.size());
+  scan_origins.emplace_back(pose.x, pose.y);
   points.reserve(points.size() + scan_points.size());
   for (const auto& point : scan_points) points.push_back(pose * point);
 }
@@ -78,6 +79,54 @@ std::vector<std::uint8_t> ReferencePoints::sameScanAsNext() const {
     if (start > 0 && start <= points.size()) same[start - 1] = 0;
   }
   return same;
+}
+
+namespace {
+
+constexpr double kMaxJoinStep = 2.0 * M_PI / 180.0;
+
+/// Median bearing step between consecutive finite points of reference[begin, end), seen from `origin`.
+double medianAngularStep(const std::vector<Eigen::Vector2d>& points, std::size_t begin, std::size_t end,
+                         const Eigen::Vector2d& origin) {
+  std::vector<double> steps;
+  for (std::size_t i = begin; i + 1 < end; ++i) {
+    if (!points[i].allFinite() || !points[i + 1].allFinite()) continue;
+    const Eigen::Vector2d a = points[i] - origin, b = points[i + 1] - origin;
+    steps.push_back(std::abs(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b))));
+  }
+  if (steps.empty()) return 0.0;
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  return steps[steps.size() / 2];
+}
+
+}  // namespace
+
+double angularStep(const ReferencePoints& reference, std::size_t scan) {
+  if (scan >= reference.scan_starts.size()) return 0.0;
+  return medianAngularStep(reference.points, reference.scan_starts[scan], reference.scanEnd(scan),
+                           reference.scanOrigin(scan));
+}
+
+std::vector<std::uint8_t> joinSurfaces(const ReferencePoints& reference, const SurfaceOptions& options) {
+  const std::vector<Eigen::Vector2d>& points = reference.points;
+  std::vector<std::uint8_t> joins(points.size(), 0);
+  if (!(options.max_gap > 0.0)) return joins;
+  const double incidence = options.max_incidence;
+  const double oblique = incidence > 0.0 && incidence < 0.5 * M_PI ? 1.0 / std::cos(incidence) : 0.0;
+  for (std::size_t scan = 0; scan < reference.scan_starts.size(); ++scan) {
+    const Eigen::Vector2d origin = reference.scanOrigin(scan);
+    // Capped: a scan of a few scattered points has no beam spacing (no 2D laser is coarser than ~1 deg).
+    const double step_gap = std::min(angularStep(reference, scan), kMaxJoinStep) * oblique;
+    for (std::size_t i = reference.scan_starts[scan]; i + 1 < reference.scanEnd(scan); ++i) {
+      const Eigen::Vector2d& a = points[i];
+      const Eigen::Vector2d& b = points[i + 1];
+      if (!a.allFinite() || !b.allFinite()) continue;
+      const double range = std::min((a - origin).norm(), (b - origin).norm());
+      const double max_gap = options.max_gap + range * step_gap;
+      joins[i] = (b - a).squaredNorm() < max_gap * max_gap ? 1 : 0;
+    }
+  }
+  return joins;
 }
 
 Scan selectBeams(const Scan& scan, int parity) {

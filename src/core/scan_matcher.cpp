@@ -92,18 +92,19 @@ MatcherOptions presetOptions(Preset preset) {
   // (tournament of 6, 4 elites) with 10 % bit mutation and a coarse first stage find the true pose more
   // often than the textbook 2-tournament / 3 %.
   MatcherOptions options;
-  options.table = LookupTableOptions{TableKind::kGraded, 0.04, 0.10, 0.30, 0.30, 0.10};
-  options.coarse_table = LookupTableOptions{TableKind::kGraded, 0.08, 0.30, 0.60, 0.30, 0.10};
+  options.table.cell_size = 0.04;
+  options.coarse_table.cell_size = 0.08;
+  options.coarse_table.sigma = 0.30;
+  options.coarse_table.cutoff = 0.60;
   options.genetic.tournament_size = 6;
   options.genetic.elite_count = 4;
   options.genetic.mutation_rate = 0.10;
   options.genetic.crossover_rate = 0.8;
   options.genetic.polish_evaluations = 60;
   // Measured with the evaluate tool on fr079 (all relations: rotation drift 4.3 -> 2.9 deg): once the
-  // estimate settles, a 15 cm gate and 10 % trimming keep moved objects and unmatched structure out.
+  // estimate settles, a 15 cm gate keeps moved objects and unmatched structure out.
   options.mbicp.max_distance = 0.30;
   options.mbicp.fine_max_distance = 0.15;
-  options.mbicp.trim_fraction = 0.90;
   // Measured against the relations of intel, fr079 and aces (README): with 50 the fused odometry leans on
   // the wheels where the scans know better, with 200 it takes the scans' look-alike leaps.
   options.mbicp.independent_points = 100.0;
@@ -130,7 +131,9 @@ MatcherOptions presetOptions(Preset preset) {
       // finds the true basin instead of a 180-degree look-alike more often (intel, whole box, 5 seeds of
       // 500 trials: 97.1 -> 98.6 %).
       options.genetic.coarse_generations = 6;
-      options.coarse_table = LookupTableOptions{TableKind::kGraded, 0.12, 0.60, 1.20, 0.30, 0.10};
+      options.coarse_table.cell_size = 0.12;
+      options.coarse_table.sigma = 0.60;
+      options.coarse_table.cutoff = 1.20;
       break;
   }
   // PGA pairs within the reach of GLASM's tables: the fine table's cut-off, then the coarse one's.

@@ -286,7 +286,8 @@ void readOptions(ParamTree& tree, LaserOdometryOptions* options) {
     tree.positiveNumber(prefix + "sigma", &table.sigma);
     tree.positiveNumber(prefix + "cutoff", &table.cutoff);
     tree.number(prefix + "segment_max_gap", &table.segment_max_gap, 0.0, kInf);
-    tree.nonNegativeNumber(prefix + "segment_gap_per_metre", &table.segment_gap_per_metre);
+    tree.number(prefix + "segment_max_incidence", &table.segment_max_incidence, 0.0, 0.5 * M_PI);
+    tree.nonNegativeNumber(prefix + "isolated_footprint", &table.isolated_footprint);
   }
 
   // Genetic pre-alignment.
@@ -318,9 +319,11 @@ void readOptions(ParamTree& tree, LaserOdometryOptions* options) {
   tree.nonNegativeNumber("mbicp/settle_step_xy", &mbicp.settle_step_xy);
   tree.nonNegativeNumber("mbicp/settle_step_theta", &mbicp.settle_step_theta);
   tree.nonNegativeNumber("mbicp/segment_max_gap", &mbicp.segment_max_gap);
-  tree.nonNegativeNumber("mbicp/segment_gap_per_metre", &mbicp.segment_gap_per_metre);
+  tree.number("mbicp/segment_max_incidence", &mbicp.segment_max_incidence, 0.0, 0.5 * M_PI);
   tree.boolean("mbicp/point_to_line", &mbicp.point_to_line);
+  tree.nonNegativeNumber("mbicp/robust_scale", &mbicp.robust_scale);
   tree.number("mbicp/trim_fraction", &mbicp.trim_fraction, 0.0, 1.0, true);
+  tree.nonNegativeNumber("mbicp/point_noise", &mbicp.point_noise);
   tree.positiveInteger("mbicp/max_iterations", &mbicp.max_iterations);
   tree.nonNegativeNumber("mbicp/error_ratio", &mbicp.error_ratio);
   tree.nonNegativeNumber("mbicp/min_step_xy", &mbicp.min_step_xy);

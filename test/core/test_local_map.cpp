@@ -76,6 +76,38 @@ TEST(LocalMap, OverlappingViewsAddNothingButAKeyframeKeepsAllItsOwnPoints) {
   EXPECT_EQ(map.reference().scan_starts.size(), 2u) << "the second keyframe added no point";
 }
 
+TEST(LocalMap, AKeptPointKeepsItsNeighbouringBeamsSoItsSurfaceStaysASurface) {
+  LocalMapOptions options;
+  options.resolution = 0.03;
+  LocalMap map(options);
+  // The first keyframe sees the wall at y = 0, 0.4, 0.8 and 1.2.
+  map.add(Pose2D(), {Eigen::Vector2d(2.0, 0.0), Eigen::Vector2d(2.0, 0.4), Eigen::Vector2d(2.0, 0.8),
+                     Eigen::Vector2d(2.0, 1.2)});
+  // The second sees it every 0.1 m from y = 0 to 1.6, some beams on an object 0.5 m behind: only
+  // y = 0, 0.4, 0.8 and 1.2 are covered, and each stays as the neighbouring beam of a new point (alone,
+  // the new points between them would be loose pairs and triples).
+  std::vector<Eigen::Vector2d> second;
+  for (int k = 0; k <= 16; ++k) second.emplace_back(2.0, 0.1 * k);
+  for (int k : {1, 2, 3, 9, 10, 11}) second[k].x() = 2.5;  // 0.5 m behind: not covered either
+  map.add(Pose2D(), second);
+  const hglasm::ReferencePoints& reference = map.reference();
+  ASSERT_EQ(reference.scan_starts.size(), 2u);
+  std::vector<double> kept_y;
+  for (std::size_t i = reference.scan_starts[1]; i < reference.size(); ++i)
+    kept_y.push_back(reference.points[i].y());
+  const std::vector<double> expected = {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8,
+                                        0.9, 1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6};
+  ASSERT_EQ(kept_y.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_NEAR(kept_y[i], expected[i], 1e-9) << i;
+  // A run of covered beams loses its inner points only.
+  LocalMap other(options);
+  other.add(Pose2D(), wall(2.0, 1.0, 0.1));
+  std::vector<Eigen::Vector2d> extended = wall(2.0, 1.0, 0.1);
+  extended.emplace_back(2.0, 1.3);  // one new beam past the end: it and its neighbour stay
+  other.add(Pose2D(), extended);
+  EXPECT_EQ(other.reference().size(), wall(2.0, 1.0, 0.1).size() + 2);
+}
+
 TEST(LocalMap, SurfacesAreNeverJoinedAcrossKeyframes) {
   LocalMapOptions options;
   options.resolution = 0.0;

@@ -20,7 +20,8 @@ constexpr double kCell = 0.02;
 constexpr double kSigma = 0.10;
 constexpr double kCutoff = 0.30;
 
-/// The papers' point-only table: the distance is to the nearest reference point (no joining segments).
+/// The papers' point-only table: the distance is to the nearest reference point (no joining segments, no
+/// footprints).
 LookupTableOptions gradedOptions() {
   LookupTableOptions options;
   options.kind = TableKind::kGraded;
@@ -28,6 +29,7 @@ LookupTableOptions gradedOptions() {
   options.sigma = kSigma;
   options.cutoff = kCutoff;
   options.segment_max_gap = 0.0;
+  options.isolated_footprint = 0.0;
   return options;
 }
 
@@ -113,10 +115,9 @@ TEST(LookupTable, CellsHoldTheLikelihoodOfTheNearestPointNotASum) {
 TEST(LookupTable, SegmentsJoinCloseConsecutivePointsOnly) {
   LookupTableOptions options = gradedOptions();
   options.segment_max_gap = 0.30;
-  options.segment_gap_per_metre = 0.10;
+  options.segment_max_incidence = 0.0;  // the gap alone
   LookupTable table(options);
-  // Beam order: a and b are 0.24 m apart (joined); b and c are 1.0 m apart at about 1 m range (not joined:
-  // the allowed gap there is 0.3 + 0.1 * 1 = 0.4 m).
+  // Beam order: a and b are 0.24 m apart (joined); b and c are 1.0 m apart (not joined).
   const Eigen::Vector2d a = kCentre, b = kCentre + Eigen::Vector2d(12 * kCell, 0.0),
                         c = b + Eigen::Vector2d(0.0, 50 * kCell);
   table.build({a, b, c});
@@ -300,3 +301,52 @@ TEST(LookupTable, OtherCellSizesAndSigmas) {
 }
 
 }  // namespace
+
+TEST(LookupTable, AnIsolatedPointIsStampedAcrossItsBeamAsWideAsItsAngularStep) {
+  // Two isolated points 8 m out, 2 degrees apart as seen from the origin (0.28 m: not joined with the
+  // gap alone). Each stands for the surface over its beam's angular cell: +-0.14 m across the beam.
+  LookupTableOptions options = gradedOptions();
+  options.segment_max_gap = 0.05;
+  options.segment_max_incidence = 0.0;
+  options.isolated_footprint = 1.0;
+  const double step = 2.0 * M_PI / 180.0, range = 8.0;
+  const Eigen::Vector2d a(range, 0.0), b(range * std::cos(step), range * std::sin(step));
+  LookupTable table(options);
+  table.build({a, b});
+  options.isolated_footprint = 0.0;
+  LookupTable point_only(options);
+  point_only.build({a, b});
+  const Eigen::Vector2d across(0.0, 1.0), along(1.0, 0.0);  // at a
+  const double half_width = 0.5 * range * step;
+  for (double offset : {0.0, 0.5 * half_width, 0.95 * half_width}) {
+    EXPECT_GE(table.valueAt(a - offset * across), 240) << offset;
+    EXPECT_GE(table.valueAt(b - offset * Eigen::Vector2d(-std::sin(step), std::cos(step))), 240) << offset;
+  }
+  EXPECT_LT(point_only.valueAt(a - 0.95 * half_width * across), 130);
+  // Beyond the footprint it decays from its end (2 sigma: 255 exp(-2) = 35); the point alone is past the
+  // cutoff there.
+  const double beyond = table.valueAt(a - (half_width + 2.0 * kSigma) * across);
+  EXPECT_GT(beyond, 15);
+  EXPECT_LT(beyond, 60);
+  EXPECT_EQ(point_only.valueAt(a - (half_width + 2.0 * kSigma) * across), 0);
+  // Along the beam it is still a point.
+  EXPECT_LT(table.valueAt(a + 2.0 * kSigma * along), 60);
+}
+
+TEST(LookupTable, JoinedPointsGetNoFootprintAndAFewScatteredPointsNoHugeOne) {
+  LookupTableOptions options = gradedOptions();
+  options.segment_max_gap = 0.30;
+  options.isolated_footprint = 1.0;
+  // A wall 2 m out, points 2 cm apart: joined, so its end is not stamped further along it.
+  std::vector<Eigen::Vector2d> wall;
+  for (int k = -20; k <= 20; ++k) wall.emplace_back(2.0, 0.02 * k);
+  LookupTable table(options);
+  table.build(wall);
+  EXPECT_LT(table.valueAt(Eigen::Vector2d(2.0, 0.48)), 220);
+  // Three points 90 degrees apart at 100 m: the footprint is capped (0.5 m), not 78 m wide.
+  LookupTable scattered(options);
+  scattered.build({Eigen::Vector2d(100.0, 0.0), Eigen::Vector2d(0.0, 100.0), Eigen::Vector2d(-100.0, 0.0)});
+  EXPECT_GE(scattered.valueAt(Eigen::Vector2d(100.0, 0.45)), 240);
+  EXPECT_EQ(scattered.valueAt(Eigen::Vector2d(100.0, 0.5 + kCutoff + 0.05)), 0);
+  EXPECT_LT(scattered.memoryBytes(), std::size_t(1) << 20);
+}

@@ -414,4 +414,55 @@ TEST(Mbicp, SeveralScansAsOneReference) {
   expectExact(mbicp.match(hglasm_test::simulateScan(world, truth, laser), Pose2D()), truth);
 }
 
+TEST(Mbicp, RobustWeightsKeepAnObjectThatMovedNextToAWallFromPullingThePose) {
+  // In the new scan a box (a person, a cart) stands 8 cm in front of a wall where the reference saw the
+  // wall: its points lie within the association gate. Weighted by their distance they barely vote;
+  // unweighted (robust_scale 0) they pull the scan towards the wall.
+  const auto laser = hglasm_test::fullCircleLaser(720);
+  const Pose2D truth(0.1, -0.05, 0.03);
+  auto world = hglasm_test::room();
+  Mbicp robust, plain([] {
+    hglasm::MbicpOptions options;
+    options.robust_scale = 0.0;
+    return options;
+  }());
+  robust.setReference(hglasm_test::simulateScan(world, Pose2D(), laser));
+  plain.setReference(hglasm_test::simulateScan(world, Pose2D(), laser));
+  hglasm_test::addBox(&world, 5.92, -1.5, 0.04, 1.2);  // along the wall x = 6, 4..12 cm in front of it
+  const hglasm::Scan scan = hglasm_test::simulateScan(world, truth, laser);
+  const MbicpResult weighted = robust.match(scan, Pose2D()), unweighted = plain.match(scan, Pose2D());
+  expectSane(weighted);
+  const double weighted_error = hglasm_test::translationError(weighted.pose, truth);
+  const double unweighted_error = hglasm_test::translationError(unweighted.pose, truth);
+  EXPECT_LT(weighted_error, 0.004) << describe(weighted);
+  EXPECT_GT(unweighted_error, 2.0 * weighted_error) << describe(unweighted);
+}
+
+TEST(Mbicp, AnIsolatedFarPointDoesNotTurnTheScanByWhereInItsBeamItWasSampled) {
+  // A wall 2 m to the side seen every degree, and a post 8 m ahead. In the new scan (truth: the identity)
+  // the laser sampled the post 4 cm to the side of where the reference did, well within the 14 cm its
+  // 1-degree beam covers there. Point-to-point, that residual turns the scan (the wall resists only
+  // through its lever arm); weighed against the beam spacing it counts by 1e-4 / (1e-4 + 0.14^2 / 12).
+  hglasm::Scan reference, scan;
+  for (int bearing = 40; bearing <= 140; ++bearing) {
+    const double angle = bearing * M_PI / 180.0;
+    reference.points.emplace_back(2.0 / std::tan(angle), 2.0);
+  }
+  scan.points = reference.points;
+  reference.points.emplace_back(8.0, 0.0);
+  scan.points.emplace_back(8.0, 0.04);
+  const auto turn = [&](double point_noise) {
+    hglasm::MbicpOptions options;
+    options.point_noise = point_noise;
+    Mbicp mbicp(options);
+    mbicp.setReference(reference);
+    const MbicpResult result = mbicp.match(scan, Pose2D());
+    expectSane(result);
+    return std::abs(result.pose.theta);
+  };
+  const double modelled = turn(0.01), point_to_point = turn(0.0);
+  EXPECT_LT(modelled, 0.25 * point_to_point) << modelled << " vs " << point_to_point;
+  EXPECT_GT(point_to_point, deg(0.01)) << "the scenario must be able to turn the scan";
+}
+
 }  // namespace

@@ -335,3 +335,87 @@ TEST(DeskewScan, StraightensAWallSweptWhileDriving) {
 }
 
 }  // namespace
+
+// ------------------------------------------------------------------ surfaces: which neighbours are joined
+
+namespace {
+
+/// A straight wall seen from `origin` at `incidence` (angle between beam and wall normal at the middle
+/// beam), `range` away along the middle beam, sampled every `step` radians: consecutive points in beam order.
+std::vector<Eigen::Vector2d> obliqueWall(double range, double incidence, double step, int beams) {
+  // Wall through (range, 0) with normal at angle `incidence` from the x axis.
+  const Eigen::Vector2d point(range, 0.0), normal(std::cos(incidence), std::sin(incidence));
+  std::vector<Eigen::Vector2d> points;
+  for (int k = -beams / 2; k <= beams / 2; ++k) {
+    const Eigen::Vector2d direction(std::cos(k * step), std::sin(k * step));
+    points.push_back(direction * (normal.dot(point) / normal.dot(direction)));
+  }
+  return points;
+}
+
+}  // namespace
+
+TEST(ReferencePoints, AppendRecordsEachScansOrigin) {
+  hglasm::ReferencePoints reference;
+  reference.append({Eigen::Vector2d(1.0, 0.0)}, hglasm::Pose2D(2.0, 3.0, 0.5));
+  reference.append({}, hglasm::Pose2D(9.0, 9.0, 0.0));  // empty: no scan
+  reference.append({Eigen::Vector2d(1.0, 0.0), Eigen::Vector2d(2.0, 0.0)}, hglasm::Pose2D(-1.0, 0.0, 0.0));
+  ASSERT_EQ(reference.scan_origins.size(), 2u);
+  EXPECT_EQ(reference.scanOrigin(0), Eigen::Vector2d(2.0, 3.0));
+  EXPECT_EQ(reference.scanOrigin(1), Eigen::Vector2d(-1.0, 0.0));
+  EXPECT_EQ(reference.scanEnd(0), 1u);
+  EXPECT_EQ(reference.scanEnd(1), 3u);
+  reference.clear();
+  EXPECT_TRUE(reference.scan_origins.empty());
+}
+
+TEST(AngularStep, IsTheBeamSpacingSeenFromTheScansOriginDespiteMissingBeams) {
+  const double step = hglasm_test::deg(0.5);
+  std::vector<Eigen::Vector2d> points = obliqueWall(4.0, 0.3, step, 60);
+  points.erase(points.begin() + 10, points.begin() + 14);  // a gap of missing beams
+  points[30] = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  hglasm::ReferencePoints reference;
+  const hglasm::Pose2D origin(5.0, -2.0, 1.0);
+  reference.append(points, origin);  // in another frame: seen from its own origin the spacing is the same
+  EXPECT_NEAR(hglasm::angularStep(reference, 0), step, 1e-9);
+  EXPECT_EQ(hglasm::angularStep(reference, 1), 0.0) << "no such scan";
+}
+
+TEST(JoinSurfaces, FollowTheLasersResolutionUpToTheMaximumIncidence) {
+  // 1 degree beams at 10 m: consecutive points of a wall are about 0.17 m / cos(incidence) apart.
+  const double step = hglasm_test::deg(1.0);
+  hglasm::SurfaceOptions options;  // 0.30 m, 80 degrees
+  for (double incidence_deg : {0.0, 60.0, 75.0, 84.0}) {
+    SCOPED_TRACE(incidence_deg);
+    hglasm::ReferencePoints reference;
+    reference.append(obliqueWall(10.0, hglasm_test::deg(incidence_deg), step, 4));
+    const std::vector<std::uint8_t> joins = hglasm::joinSurfaces(reference, options);
+    ASSERT_EQ(joins.size(), 5u);
+    EXPECT_EQ(joins[4], 0) << "the last point has no next";
+    // A gap of 0.17 / cos(i) m: within 0.30 m below 55 deg, within 0.30 + 10 * step / cos(80) ~ 1.3 m
+    // below 80 deg, beyond it at 84 deg.
+    const int expected = incidence_deg < 80.0 ? 1 : 0;
+    for (int i = 0; i < 4; ++i) EXPECT_EQ(joins[i], expected) << i;
+    // The gap alone (max_incidence 0): only what is within 0.30 m.
+    hglasm::SurfaceOptions gap_only = options;
+    gap_only.max_incidence = 0.0;
+    const std::vector<std::uint8_t> by_gap = hglasm::joinSurfaces(reference, gap_only);
+    for (int i = 0; i < 4; ++i) {
+      const double gap = (reference.points[i + 1] - reference.points[i]).norm();
+      EXPECT_EQ(by_gap[i], gap < 0.30 ? 1 : 0) << i << " gap " << gap;
+    }
+  }
+}
+
+TEST(JoinSurfaces, NeverAcrossScansMissingBeamsOrWithMaxGapZero) {
+  hglasm::ReferencePoints reference;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  reference.append({Eigen::Vector2d(2.0, 0.0), Eigen::Vector2d(2.0, 0.05), Eigen::Vector2d(nan, nan),
+                    Eigen::Vector2d(2.0, 0.15)});
+  reference.append({Eigen::Vector2d(2.0, 0.2), Eigen::Vector2d(2.0, 0.25)});
+  EXPECT_EQ(hglasm::joinSurfaces(reference, hglasm::SurfaceOptions()),
+            (std::vector<std::uint8_t>{1, 0, 0, 0, 1, 0}));
+  hglasm::SurfaceOptions off;
+  off.max_gap = 0.0;
+  EXPECT_EQ(hglasm::joinSurfaces(reference, off), std::vector<std::uint8_t>(6, 0));
+}

@@ -508,15 +508,17 @@ TEST_F(OdometryReplay, ShippedYamlValidatesAndMatchesTheBuiltInPresets) {
         EXPECT_DOUBLE_EQ(a.sigma, b.sigma) << name << " table " << t;
         EXPECT_DOUBLE_EQ(a.cutoff, b.cutoff) << name << " table " << t;
         EXPECT_DOUBLE_EQ(a.segment_max_gap, b.segment_max_gap) << name << " table " << t;
-        EXPECT_DOUBLE_EQ(a.segment_gap_per_metre, b.segment_gap_per_metre) << name << " table " << t;
+        EXPECT_DOUBLE_EQ(a.segment_max_incidence, b.segment_max_incidence) << name << " table " << t;
+        EXPECT_DOUBLE_EQ(a.isolated_footprint, b.isolated_footprint) << name << " table " << t;
       }
       const hglasm::MbicpOptions &m = got.mbicp, &n = expected.mbicp;
       EXPECT_DOUBLE_EQ(m.metric_l, n.metric_l) << name;
       EXPECT_DOUBLE_EQ(m.bearing_window, n.bearing_window) << name;
       EXPECT_DOUBLE_EQ(m.max_distance, n.max_distance) << name;
       EXPECT_DOUBLE_EQ(m.segment_max_gap, n.segment_max_gap) << name;
-      EXPECT_DOUBLE_EQ(m.segment_gap_per_metre, n.segment_gap_per_metre) << name;
-      EXPECT_DOUBLE_EQ(m.trim_fraction, n.trim_fraction) << name;
+      EXPECT_DOUBLE_EQ(m.segment_max_incidence, n.segment_max_incidence) << name;
+      EXPECT_DOUBLE_EQ(m.robust_scale, n.robust_scale) << name;
+      EXPECT_DOUBLE_EQ(m.point_noise, n.point_noise) << name;
       EXPECT_EQ(m.max_iterations, n.max_iterations) << name;
       EXPECT_DOUBLE_EQ(m.error_ratio, n.error_ratio) << name;
       EXPECT_DOUBLE_EQ(m.min_step_xy, n.min_step_xy) << name;

@@ -63,6 +63,7 @@ class LocalMap {
   // Scratch of rebuild(): kept points by grid cell (cell side = resolution).
   std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> cells_;
   std::vector<Eigen::Vector2d> kept_;  // in the keyframe's frame
+  std::vector<std::uint8_t> covered_;  // per point of the keyframe being added: an older keyframe has it
 };
 
 }  // namespace hglasm

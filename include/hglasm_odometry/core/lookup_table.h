@@ -23,11 +23,18 @@ struct LookupTableOptions {
   double cell_size = 0.02;  ///< metres
   double sigma = 0.10;      ///< metres: graded spread; half-side of the binary square
   double cutoff = 0.30;     ///< metres: graded cells farther than this from every reference point hold 0
-  /// Consecutive reference points closer than segment_max_gap + segment_gap_per_metre * range are joined:
-  /// the table then holds the distance to the scanned surface, not just to its (sparse, far) samples.
-  /// segment_max_gap <= 0 turns this off (the papers' point-only table).
-  double segment_max_gap = 0.30;  ///< metres
-  double segment_gap_per_metre = 0.10;
+  /// Consecutive reference points of one surface (SurfaceOptions: within segment_max_gap, or the gap a
+  /// surface seen at up to segment_max_incidence leaves between beams) are joined: the table then holds
+  /// the distance to the scanned surface, not just to its (sparse, far) samples. segment_max_gap <= 0
+  /// turns this off (the papers' point-only table).
+  double segment_max_gap = 0.30;                      ///< metres
+  double segment_max_incidence = 1.3962634015954636;  ///< radians (80 degrees)
+  /// An isolated reference point (joined to neither neighbour) stands for the surface its beam hit, which
+  /// lies anywhere within the beam's angular cell: it is stamped as a short line across its beam, this
+  /// fraction of the scan's angular step wide (range * step * footprint). A far sparse point then scores a
+  /// new point that sampled the same surface a little to its side, as a joined surface would. 0: a point.
+  double isolated_footprint = 1.0;
+  SurfaceOptions surface() const { return SurfaceOptions{segment_max_gap, segment_max_incidence}; }
 };
 
 /// Points prepared for repeated fitness evaluation (single precision, structure of arrays, so the
@@ -78,8 +85,15 @@ class LookupTable {
 
   /// Reference coordinates beyond this are ignored, so a wild (but finite) reading cannot blow up the index.
   static constexpr double kMaxCoordinate = 500.0;
+  static constexpr double kMaxFootprint = 0.5;  ///< metres: half-width cap of an isolated point's stamp
 
+  static bool withinTable(const Eigen::Vector2d& p) {
+    return std::abs(p.x()) <= kMaxCoordinate && std::abs(p.y()) <= kMaxCoordinate;  // false for NaN
+  }
   void buildKernel();
+  /// Adds samples across the beam of each isolated reference point (isolated_footprint).
+  void stampFootprints(const ReferencePoints& reference, const std::vector<std::uint8_t>& joins,
+                       double spacing);
 
   /// Calls f(cell value) for every point of `points` moved by `pose` that lands on an allocated tile.
   /// One transform and one byte read per point: the cell scaling is folded into the transform, which runs

@@ -19,11 +19,16 @@ struct MbicpOptions {
   double fine_max_distance = 0.15;
   double settle_step_xy = 0.01;      ///< metres
   double settle_step_theta = 0.005;  ///< radians
-  /// Consecutive reference points form a segment if they are closer than
-  /// segment_max_gap + segment_gap_per_metre * range (beams diverge with range).
-  double segment_max_gap = 0.30;  ///< metres
-  double segment_gap_per_metre = 0.10;
-  double trim_fraction = 0.95;  ///< keep this fraction of the best associations
+  /// Consecutive reference points form a segment if they sample one surface (SurfaceOptions: within
+  /// segment_max_gap, or the gap a surface seen at up to segment_max_incidence leaves between beams).
+  double segment_max_gap = 0.30;                      ///< metres
+  double segment_max_incidence = 1.3962634015954636;  ///< radians (80 degrees)
+  /// Robust weights instead of trimming: an association at distance d weighs 1 / (1 + d^2 / c^2) (Cauchy),
+  /// c = robust_scale times the median association distance (not below robust_scale * point_noise). With
+  /// 3 (about 2 sigma of Gaussian inliers) a wall seen by a tenth of the points still votes, where trimming
+  /// the worst tenth would drop it whole; clutter and moved objects fade smoothly. <= 0: no weights.
+  double robust_scale = 3.0;
+  double trim_fraction = 1.0;  ///< keep this fraction of the best associations (1: all)
   int max_iterations = 50;
   double error_ratio = 1e-4;            ///< |E_k - E_k-1| / E_k below this counts as no progress
   double min_step_xy = 1e-4;            ///< metres: a step smaller than this counts as no progress
@@ -41,6 +46,12 @@ struct MbicpOptions {
   /// not know n times more than one: sigma^2 H^-1 over hundreds of points is far too confident. Measured
   /// against the relations of the Freiburg logs (README); 0 = every point independent (sigma^2 H^-1).
   double independent_points = 0.0;
+  /// metres: a laser point's own noise, weighed against where along its beam's neighbourhood the
+  /// reference sampled the surface. A new point associated with an isolated reference point may truly
+  /// lie anywhere between that point's neighbouring beams (|p| times the angular spacing, which grows
+  /// with range): its residual across the beam counts by point_noise^2 / (point_noise^2 + spacing^2 / 12),
+  /// so a sparse far point cannot turn the scan by its beam spacing. <= 0: point-to-point as MbICP.
+  double point_noise = 0.01;
 };
 
 /// A Gaussian belief about the pose being estimated (the new scan in the reference frame), e.g. the
@@ -57,8 +68,8 @@ struct MbicpResult {
   Pose2D pose;  ///< new scan's pose in the reference frame
   MbicpStatus status = MbicpStatus::kTooFewAssociations;
   int iterations = 0;
-  int associations = 0;    ///< associations kept (after trimming) in the last iteration
-  double rms_error = 0.0;  ///< metres, sqrt(mean d_ap^2) of kept associations
+  int associations = 0;    ///< associations in the last iteration
+  double rms_error = 0.0;  ///< metres, sqrt(robust-weighted mean d_ap^2) of the associations
   /// 3x3 covariance of (x, y, theta) at the final pose: sigma^2 * H^-1, where H is the point-to-line
   /// information of the final associations (each residual projected on the reference surface normal, so
   /// sliding along a featureless corridor shows as a large variance) and sigma^2 their residual variance.
@@ -100,24 +111,36 @@ class Mbicp {
     Eigen::Vector2d normal;  // reference surface normal there (zero for an isolated point)
     bool on_segment;         // target lies inside a reference segment (normal = the segment's)
     double distance_sq;      // d_ap^2
+    // Isolated reference point: unit direction across its beam and the variance of where along it the
+    // surface was sampled (zero otherwise).
+    Eigen::Vector2d sampling_tangent;
+    double sampling_variance;
+    double weight;  // robust weight of the last step (1 without robust_scale)
   };
+  /// Per kept reference point: the direction across its beam and the variance of its sampling along it.
+  void computeSamplingUncertainty(const ReferencePoints& reference,
+                                  const std::vector<std::size_t>& scan_of_point);
   void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) const;
-  /// Trims the worst associations and solves for the increment (pose = increment * pose); false if the
-  /// system has no finite solution.
+  /// Weighs the associations (robust_scale) and solves for the increment (pose = increment * pose); false if
+  /// the system has no finite solution. c^2 of the robust weights for the current associations (0: no
+  /// weights).
+  double robustScaleSq() const;
   bool solveStep(const Pose2D& pose, bool settled, std::size_t min_associations, const PosePrior* prior,
                  Eigen::Vector3d* step, Eigen::Vector3d* scan_only_step, double* error);
   /// Covariance, calibrated scan information and degeneracy at the final pose from the final associations.
   void estimateUncertainty(const PosePrior* prior, MbicpResult* result) const;
   /// Share of the information of `constraints` associations that counts (independent_points).
-  double informationScale(std::size_t constraints) const;
+  double informationScale(double constraints) const;
 
   MbicpOptions options_;
-  std::vector<Eigen::Vector2d> ref_points_;   // in beam order
-  std::vector<std::int8_t> ref_has_next_;     // segment from point i to i+1
-  std::vector<Eigen::Vector2d> ref_normals_;  // unit surface normal at each point (zero if isolated)
-  std::vector<double> sorted_bearing_;        // bearings of reference points, ascending
-  std::vector<int> sorted_index_;             // their indices into ref_points_
-  std::vector<Association> associations_;     // scratch
+  std::vector<Eigen::Vector2d> ref_points_;    // in beam order
+  std::vector<std::int8_t> ref_has_next_;      // segment from point i to i+1
+  std::vector<Eigen::Vector2d> ref_normals_;   // unit surface normal at each point (zero if isolated)
+  std::vector<Eigen::Vector2d> ref_tangents_;  // unit direction across each point's beam
+  std::vector<double> ref_sampling_variance_;  // (range * angular spacing)^2 / 12 of each point
+  std::vector<double> sorted_bearing_;         // bearings of reference points, ascending
+  std::vector<int> sorted_index_;              // their indices into ref_points_
+  std::vector<Association> associations_;      // scratch
   Eigen::Matrix3d scan_information_ = Eigen::Matrix3d::Zero();  // of the last step, increment coordinates
   std::vector<Eigen::Vector2d> moved_;                          // scratch
 };

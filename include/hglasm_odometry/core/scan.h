@@ -59,7 +59,8 @@ struct Scan {
 /// points of different scans never are.
 struct ReferencePoints {
   std::vector<Eigen::Vector2d> points;
-  std::vector<std::size_t> scan_starts;  ///< index of each scan's first point, ascending
+  std::vector<std::size_t> scan_starts;       ///< index of each scan's first point, ascending
+  std::vector<Eigen::Vector2d> scan_origins;  ///< each scan's sensor position in this set's frame
 
   /// Appends a scan's points moved by `pose` (the scan's frame in this set's frame) as a new scan.
   void append(const std::vector<Eigen::Vector2d>& scan_points, const Pose2D& pose = Pose2D());
@@ -68,11 +69,39 @@ struct ReferencePoints {
   std::vector<std::uint8_t> sameScanAsNext() const;
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }
+  /// One past the last point of scan `scan`.
+  std::size_t scanEnd(std::size_t scan) const {
+    return scan + 1 < scan_starts.size() ? scan_starts[scan + 1] : points.size();
+  }
+  /// Sensor position of scan `scan` (the set's origin if it was not recorded).
+  Eigen::Vector2d scanOrigin(std::size_t scan) const {
+    return scan < scan_origins.size() ? scan_origins[scan] : Eigen::Vector2d::Zero();
+  }
   void clear() {
     points.clear();
     scan_starts.clear();
+    scan_origins.clear();
   }
 };
+
+/// When two consecutive points of one scan count as samples of one surface (the lookup table joins them
+/// with a line of samples, MbICP with a segment).
+struct SurfaceOptions {
+  double max_gap = 0.30;  ///< metres: neighbours this close are joined at any range; <= 0: never join
+  /// radians: farther neighbours are joined if a flat surface seen this obliquely would leave their gap
+  /// between neighbouring beams (range * the scan's angular step / cos(max_incidence)), so the rule
+  /// follows each laser's resolution. <= 0: max_gap alone.
+  double max_incidence = 1.3962634015954636;  // 80 degrees
+};
+
+/// Median bearing step between consecutive finite points of scan `scan` of `reference`, seen from its
+/// origin: the scan's angular resolution (missing beams widen some steps, not the median). 0 with fewer
+/// than two points.
+double angularStep(const ReferencePoints& reference, std::size_t scan);
+
+/// For each point of `reference`: 1 if it and the next point are joined under `options` (same scan, both
+/// finite, the gap small enough), else 0.
+std::vector<std::uint8_t> joinSurfaces(const ReferencePoints& reference, const SurfaceOptions& options);
 
 /// Why a RangeScan could not be converted at all (its points are then empty).
 enum class ScanError { kNone, kNoBeams, kBadAngles, kBadRangeLimits };

@@ -38,11 +38,20 @@ enum class Preset { kSmall, kMedium, kLarge };
 const char* toString(Preset preset);
 bool parsePreset(const std::string& name, Preset* preset);
 
+/// The coarse table's defaults: a wider basin than the fine table's.
+inline LookupTableOptions coarseTableOptions() {
+  LookupTableOptions options;
+  options.cell_size = 0.06;
+  options.sigma = 0.30;
+  options.cutoff = 0.60;
+  return options;
+}
+
 struct MatcherOptions {
   Algorithm algorithm = Algorithm::kHglasmG;
   LookupTableOptions table;  ///< `kind` is overridden by the algorithm
   /// Table for the GA's first genetic.coarse_generations generations (same kind as `table`).
-  LookupTableOptions coarse_table{TableKind::kGraded, 0.06, 0.30, 0.60, 0.30, 0.10};
+  LookupTableOptions coarse_table = coarseTableOptions();
   GeneticOptions genetic;
   MbicpOptions mbicp;
   PolarPairingOptions pga;  ///< PGA / HPGA only
