@@ -24,7 +24,7 @@
 
 #include "hglasm_odometry/Match.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
-#include "hglasm_odometry/core/relations.h"
+#include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/conversions.h"
 
 namespace {

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "hglasm_odometry/core/carmen_log.h"
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
-#include "hglasm_odometry/core/success_ratio.h"
+#include "hglasm_odometry/evaluation/carmen_log.h"
+#include "hglasm_odometry/evaluation/success_ratio.h"
 #include "hglasm_odometry/ros/bag_reader.h"
 
 namespace {

@@ -1,4 +1,4 @@
-#include "hglasm_odometry/core/success_ratio.h"
+#include "hglasm_odometry/evaluation/success_ratio.h"
 
 #include <algorithm>
 #include <chrono>

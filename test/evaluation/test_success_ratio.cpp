@@ -1,5 +1,5 @@
 // The Success-Ratio protocol on simulated scans, where every answer is known exactly.
-#include "hglasm_odometry/core/success_ratio.h"
+#include "hglasm_odometry/evaluation/success_ratio.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "test_util.h"
+#include "../core/test_util.h"
 
 namespace hglasm {
 namespace {
