@@ -18,7 +18,7 @@
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
 #include "hglasm_odometry/evaluation/carmen_log.h"
-#include "hglasm_odometry/evaluation/success_ratio.h"
+#include "hglasm_odometry/evaluation/success_ratio_report.h"
 #include "hglasm_odometry/ros/bag_reader.h"
 
 namespace {
