@@ -20,8 +20,8 @@
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
 #include "hglasm_odometry/evaluation/relations.h"
-#include "hglasm_odometry/ros/bag_reader.h"
 #include "hglasm_odometry/ros/parameters.h"
+#include "hglasm_odometry/tools/bag_reader.h"
 
 #include <xmlrpcpp/XmlRpcValue.h>
 

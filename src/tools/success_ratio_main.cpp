@@ -19,7 +19,7 @@
 #include "hglasm_odometry/core/scan_matcher.h"
 #include "hglasm_odometry/evaluation/carmen_log.h"
 #include "hglasm_odometry/evaluation/success_ratio_report.h"
-#include "hglasm_odometry/ros/bag_reader.h"
+#include "hglasm_odometry/tools/bag_reader.h"
 
 namespace {
 

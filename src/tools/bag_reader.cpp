@@ -1,5 +1,5 @@
 // Reads scans, wheel odometry and the base -> laser mounting from a bag with the rosbag C++ API.
-#include "hglasm_odometry/ros/bag_reader.h"
+#include "hglasm_odometry/tools/bag_reader.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

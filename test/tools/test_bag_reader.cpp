@@ -11,7 +11,7 @@
 #include <tf2/LinearMath/Quaternion.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "hglasm_odometry/ros/bag_reader.h"
+#include "hglasm_odometry/tools/bag_reader.h"
 
 namespace hglasm_odometry {
 namespace {

@@ -10,8 +10,8 @@
 
 #include "hglasm_odometry/core/odometry_pipeline.h"
 #include "hglasm_odometry/evaluation/relations.h"
-#include "hglasm_odometry/ros/bag_reader.h"
 #include "hglasm_odometry/ros/parameters.h"
+#include "hglasm_odometry/tools/bag_reader.h"
 
 namespace hglasm_odometry {
 namespace {
