@@ -1,8 +1,6 @@
 // evaluate: runs the nodelet's odometry pipeline (hglasm::OdometryPipeline, same options and YAML)
 // over a bag as fast as the CPU allows, without a ROS master, and scores it on the Kümmerle et al.
 // relations benchmark next to the bag's raw wheel odometry.
-#include <stdio.h>
-#include <stdlib.h>
 #include <time.h>
 
 #include <algorithm>
@@ -22,6 +20,7 @@
 #include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/parameters.h"
 #include "hglasm_odometry/tools/bag_reader.h"
+#include "hglasm_odometry/tools/yaml_parameters.h"
 
 #include <xmlrpcpp/XmlRpcValue.h>
 
@@ -175,39 +174,6 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
   return true;
 }
 
-/// Loads a YAML file exactly as roslaunch's <rosparam file=...> does: with rosparam's own Python
-/// loader, handed over as XML-RPC (the parameter server's wire format). Needs no master.
-bool loadYaml(const std::string& path, XmlRpc::XmlRpcValue* value, std::string* error) {
-  // The path travels in the environment, so no shell quoting is involved.
-  setenv("HGLASM_EVALUATE_YAML", path.c_str(), 1);
-  const char* command =
-      "/usr/bin/python3 -c 'import os, sys, xmlrpc.client, rosparam\n"
-      "loaded = rosparam.load_file(os.environ[\"HGLASM_EVALUATE_YAML\"])\n"
-      "params = (loaded[0][0] if loaded else None) or {}\n"
-      "sys.stdout.write(xmlrpc.client.dumps((params,), allow_none=True))' 2>&1";
-  FILE* pipe = popen(command, "r");
-  if (!pipe) {
-    *error = "cannot run /usr/bin/python3 to read " + path;
-    return false;
-  }
-  std::string xml;
-  char buffer[4096];
-  for (std::size_t n; (n = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) xml.append(buffer, n);
-  const int status = pclose(pipe);
-  const auto start = xml.find("<value>");
-  if (status != 0 || start == std::string::npos) {
-    *error = "cannot load " + path + ": " + xml.substr(xml.find_last_of('\n', xml.size() - 2) + 1);
-    return false;
-  }
-  int offset = static_cast<int>(start);
-  *value = XmlRpc::XmlRpcValue(xml, &offset);
-  if (!value->valid() || value->getType() != XmlRpc::XmlRpcValue::TypeStruct) {
-    *error = path + " does not hold a dictionary of parameters";
-    return false;
-  }
-  return true;
-}
-
 /// The nodelet's private namespace as the launch files build it: presets.yaml under ~presets,
 /// laser_odometry.yaml at the top, then ~preset from the command line; then the nodelet's loader.
 bool loadNodeletOptions(const Arguments& args, hglasm_odometry::LaserOdometryOptions* options,
@@ -216,12 +182,12 @@ bool loadNodeletOptions(const Arguments& args, hglasm_odometry::LaserOdometryOpt
   const auto exists = [](const std::string& path) { return std::ifstream(path).good(); };
   XmlRpc::XmlRpcValue root, presets;
   if (args.config_given || exists(args.config)) {
-    if (!loadYaml(args.config, &root, error)) return false;
+    if (!hglasm_odometry::loadYamlParameters(args.config, &root, error)) return false;
   } else {
     std::printf("config        %s not found: built-in defaults\n", args.config.c_str());
   }
   if (args.presets_given || exists(args.presets)) {
-    if (!loadYaml(args.presets, &presets, error)) return false;
+    if (!hglasm_odometry::loadYamlParameters(args.presets, &presets, error)) return false;
     // Accept a presets file written either as {small: ..} or as {presets: {small: ..}}.
     if (presets.size() == 1 && presets.hasMember("presets")) {
       presets = XmlRpc::XmlRpcValue(presets["presets"]);
