@@ -19,6 +19,7 @@
 #include "hglasm_odometry/core/scan_matcher.h"
 #include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/parameters.h"
+#include "hglasm_odometry/tools/argument_parser.h"
 #include "hglasm_odometry/tools/bag_reader.h"
 #include "hglasm_odometry/tools/yaml_parameters.h"
 
@@ -78,100 +79,57 @@ struct Arguments {
   bool quiet = false;
 };
 
-bool parseArguments(int argc, char** argv, Arguments* args) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    const auto value = [&](std::string* out) {
-      if (i + 1 >= argc) {
-        std::cerr << "evaluate: " << flag << " needs a value\n";
-        return false;
-      }
-      *out = argv[++i];
-      return true;
-    };
-    const auto number = [&](double* out) {
-      std::string text;
-      if (!value(&text)) return false;
-      char* end = nullptr;
-      *out = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || *end != '\0' || !std::isfinite(*out)) {
-        std::cerr << "evaluate: " << flag << ": not a number: '" << text << "'\n";
-        return false;
-      }
-      return true;
-    };
-    double parsed = 0.0;
-    if (flag == "--help" || flag == "-h") {
-      std::cout << kUsage;
-      std::exit(0);
-    } else if (flag == "--bag") {
-      if (!value(&args->bag)) return false;
-    } else if (flag == "--scan-topic") {
-      if (!value(&args->scan_topic)) return false;
-    } else if (flag == "--odom-topic") {
-      if (!value(&args->odom_topic)) return false;
-    } else if (flag == "--config") {
-      if (!value(&args->config)) return false;
-      args->config_given = true;
-    } else if (flag == "--presets") {
-      if (!value(&args->presets)) return false;
-      args->presets_given = true;
-    } else if (flag == "--preset") {
-      if (!value(&args->preset)) return false;
-    } else if (flag == "--relations") {
-      if (!value(&args->relations)) return false;
-    } else if (flag == "--out") {
-      if (!value(&args->out)) return false;
-    } else if (flag == "--trace") {
-      if (!value(&args->trace)) return false;
-    } else if (flag == "--plot") {
-      if (!value(&args->plot)) return false;
-    } else if (flag == "--no-odom") {
-      args->use_odometry = false;
-    } else if (flag == "--quiet") {
-      args->quiet = true;
-    } else if (flag == "--direct-pairs") {
-      args->direct_pairs = true;
-    } else if (flag == "--max-scans") {
-      if (!number(&parsed) || parsed < 0) return false;
-      args->max_scans = static_cast<std::size_t>(parsed);
-    } else if (flag == "--angle-increment") {
-      if (!number(&args->angle_increment)) return false;
-      args->override_increment = true;
-    } else if (flag == "--laser-mount") {
-      std::string text;
-      if (!value(&text)) return false;
-      double x = 0.0, y = 0.0, yaw = 0.0;
-      char trailing = 0;
-      if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &x, &y, &yaw, &trailing) != 3 ||
-          !hglasm::Pose2D(x, y, yaw).isFinite()) {
-        std::cerr << "evaluate: --laser-mount expects X,Y,YAW, got '" << text << "'\n";
-        return false;
-      }
-      args->laser_mount = hglasm::Pose2D(x, y, yaw);
-      args->override_mount = true;
-    } else if (flag == "--min-scan-interval") {
-      if (!number(&args->min_scan_interval)) return false;
-    } else if (flag == "--angle-min") {
-      if (!number(&args->angle_min)) return false;
-      args->override_angle_min = true;
-    } else if (flag == "--max-span") {
-      if (!number(&args->short_span)) return false;
-    } else {
-      std::cerr << "evaluate: unknown argument '" << flag << "'\n" << kUsage;
-      return false;
-    }
-  }
-  if (args->bag.empty()) {
-    std::cerr << "evaluate: --bag is required\n" << kUsage;
+/// X,Y,YAW into a pose (metres, metres, radians).
+bool parseLaserMount(const std::string& text, hglasm::Pose2D* mount, std::string* error) {
+  double x = 0.0, y = 0.0, yaw = 0.0;
+  char trailing = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &x, &y, &yaw, &trailing) != 3 ||
+      !hglasm::Pose2D(x, y, yaw).isFinite()) {
+    *error = "expects X,Y,YAW, got '" + text + "'";
     return false;
+  }
+  *mount = hglasm::Pose2D(x, y, yaw);
+  return true;
+}
+
+/// kOk with *args filled, or what the tool should exit with.
+hglasm_odometry::ArgumentParser::Result parseArguments(int argc, char** argv, Arguments* args) {
+  using Result = hglasm_odometry::ArgumentParser::Result;
+  hglasm_odometry::ArgumentParser parser("evaluate", kUsage);
+  parser.addOption("--bag", &args->bag);
+  parser.addOption("--scan-topic", &args->scan_topic);
+  parser.addOption("--odom-topic", &args->odom_topic);
+  parser.addOption("--config", &args->config, &args->config_given);
+  parser.addOption("--presets", &args->presets, &args->presets_given);
+  parser.addOption("--preset", &args->preset);
+  parser.addOption("--relations", &args->relations);
+  parser.addOption("--out", &args->out);
+  parser.addOption("--trace", &args->trace);
+  parser.addOption("--plot", &args->plot);
+  parser.addFlag("--no-odom", &args->use_odometry, false);
+  parser.addFlag("--quiet", &args->quiet);
+  parser.addFlag("--direct-pairs", &args->direct_pairs);
+  parser.addOption("--max-scans", &args->max_scans);
+  parser.addOption("--angle-increment", &args->angle_increment, &args->override_increment);
+  parser.addOption("--angle-min", &args->angle_min, &args->override_angle_min);
+  parser.addOption("--laser-mount", [args](const std::string& text, std::string* error) {
+    args->override_mount = parseLaserMount(text, &args->laser_mount, error);
+    return args->override_mount;
+  });
+  parser.addOption("--min-scan-interval", &args->min_scan_interval);
+  parser.addOption("--max-span", &args->short_span);
+  const Result result = parser.parse(argc, argv);
+  if (result != Result::kOk) return result;
+  if (args->bag.empty()) {
+    parser.fail("--bag is required");
+    return Result::kError;
   }
   if (args->presets.empty()) {
     const auto slash = args->config.find_last_of('/');
     args->presets =
         (slash == std::string::npos ? std::string() : args->config.substr(0, slash + 1)) + "presets.yaml";
   }
-  return true;
+  return Result::kOk;
 }
 
 /// The nodelet's private namespace as the launch files build it: presets.yaml under ~presets,
@@ -631,7 +589,8 @@ void printRelations(const Arguments& args, const std::string& preset_name, const
 
 int main(int argc, char** argv) {
   Arguments args;
-  if (!parseArguments(argc, argv, &args)) return 2;
+  const auto parsed = parseArguments(argc, argv, &args);
+  if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
 
   // The nodelet's options, through the nodelet's own loader.
   hglasm_odometry::LaserOdometryOptions nodelet_options;
