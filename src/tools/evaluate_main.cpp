@@ -23,6 +23,7 @@
 #include "hglasm_odometry/tools/bag_reader.h"
 #include "hglasm_odometry/tools/yaml_parameters.h"
 
+#include <ros/package.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 namespace {
@@ -56,7 +57,7 @@ struct Arguments {
   std::string bag;
   std::string scan_topic = "/scan";
   std::string odom_topic = "/odom";
-  std::string config = HGLASM_SOURCE_DIR "/config/laser_odometry.yaml";
+  std::string config;  ///< empty until given or resolved (defaultConfig)
   bool config_given = false;
   std::string presets;
   bool presets_given = false;
@@ -124,12 +125,29 @@ hglasm_odometry::ArgumentParser::Result parseArguments(int argc, char** argv, Ar
     parser.fail("--bag is required");
     return Result::kError;
   }
-  if (args->presets.empty()) {
-    const auto slash = args->config.find_last_of('/');
-    args->presets =
-        (slash == std::string::npos ? std::string() : args->config.substr(0, slash + 1)) + "presets.yaml";
-  }
   return Result::kOk;
+}
+
+/// The installed (or devel-space) package's config/laser_odometry.yaml, found as roslaunch finds
+/// $(find hglasm_odometry): through ROS_PACKAGE_PATH, so no source path is compiled in.
+bool defaultConfig(std::string* path, std::string* error) {
+  const std::string package = ros::package::getPath("hglasm_odometry");
+  if (package.empty()) {
+    const char* search_path = std::getenv("ROS_PACKAGE_PATH");
+    *error =
+        "cannot find the package hglasm_odometry for its config/laser_odometry.yaml (ROS_PACKAGE_PATH: " +
+        std::string(search_path ? search_path : "not set") +
+        "): source the workspace's setup.bash, or give --config";
+    return false;
+  }
+  *path = package + "/config/laser_odometry.yaml";
+  return true;
+}
+
+/// presets.yaml in the directory of `config`.
+std::string presetsNextTo(const std::string& config) {
+  const auto slash = config.find_last_of('/');
+  return (slash == std::string::npos ? std::string() : config.substr(0, slash + 1)) + "presets.yaml";
 }
 
 /// The nodelet's private namespace as the launch files build it: presets.yaml under ~presets,
@@ -591,11 +609,16 @@ int main(int argc, char** argv) {
   Arguments args;
   const auto parsed = parseArguments(argc, argv, &args);
   if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
+  std::string error;
+  if (!args.config_given && !defaultConfig(&args.config, &error)) {
+    std::cerr << "evaluate: " << error << "\n";
+    return 2;
+  }
+  if (args.presets.empty()) args.presets = presetsNextTo(args.config);
 
   // The nodelet's options, through the nodelet's own loader.
   hglasm_odometry::LaserOdometryOptions nodelet_options;
   std::vector<std::string> config_warnings;
-  std::string error;
   if (!loadNodeletOptions(args, &nodelet_options, &config_warnings, &error)) {
     std::cerr << "evaluate: " << error << "\n";
     return 2;
