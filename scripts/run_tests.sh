@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # THE test command: installs what is missing (apt, Debian package names), checks the formatting, builds in
 # Release, and runs every test: core gtests, ROS-layer gtests, rostests on the bags in bags/, the
-# launch-file check, the core tests again under AddressSanitizer + UndefinedBehaviorSanitizer, and a
-# bounded libFuzzer run.
+# launch-file check, the install smoke test (scripts/install_smoke.sh), the core tests again under
+# AddressSanitizer + UndefinedBehaviorSanitizer, and a bounded libFuzzer run.
 # Exits non-zero on any failure. Usage (as root on Debian 12): bash scripts/run_tests.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,6 +26,9 @@ hglasm_build --target tests
 # ctest runs each test through devel/env.sh, which sets up the ROS environment itself.
 echo "== gtest + rostest + launch check (ctest)"
 (cd "$HGLASM_BUILD" && ctest --output-on-failure)
+
+echo "== install smoke test: install into a temporary prefix, run the nodelet from the install space"
+bash scripts/install_smoke.sh
 
 echo "== core and evaluation tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 ASAN_BUILD="$HGLASM_ROOT/build-asan"
