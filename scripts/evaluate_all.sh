@@ -60,6 +60,9 @@ print(" ".join(k for k, v in d.items() if isinstance(v, dict)))' "$presets_yaml"
   [[ -n "$presets" ]] || presets="small medium large"
 fi
 
+# evaluate's default config (and presets.yaml beside it) is this package's, found through ROS_PACKAGE_PATH.
+export ROS_PACKAGE_PATH="$package_dir${ROS_PACKAGE_PATH:+:$ROS_PACKAGE_PATH}"
+
 mkdir -p "$out_dir"
 echo "evaluate: $evaluate"
 echo "runs:     $out_dir/<log>_<preset>.{log,txt,png}"

@@ -13,6 +13,8 @@ PACKAGES=(
   libstd-msgs-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev
   libstd-srvs-dev libvisualization-msgs-dev libdiagnostic-msgs-dev
   librosbag-dev librostest-dev libgtest-dev libbenchmark-dev libeigen3-dev
+  # the offline tools: parameter YAML, package paths
+  libyaml-cpp-dev libroslib-dev
   # .msg definitions (needed by genmsg) and Python message modules (rostopic, rostest)
   ros-std-msgs ros-sensor-msgs ros-nav-msgs ros-geometry-msgs ros-std-srvs ros-visualization-msgs
   ros-diagnostic-msgs python3-std-msgs python3-sensor-msgs python3-nav-msgs python3-geometry-msgs

@@ -24,6 +24,10 @@ steps="${STEPS:-1 2 3}"
 for f in "$bin/evaluate" "$bin/laser_odometry_node"; do
   [ -x "$f" ] || { echo "missing $f: build first (scripts/run_tests.sh or hglasm_build)" >&2; exit 2; }
 done
+# The devel space: evaluate finds its default config through ROS_PACKAGE_PATH, the node its libraries.
+set +u  # catkin's setup scripts read unset variables
+source "$HGLASM_BUILD/devel/setup.bash"
+set -u
 echo "logs in $out"
 status=0
 
@@ -70,9 +74,6 @@ rosparam set /use_sim_time true
 rosparam load config/presets.yaml /laser_odometry/presets
 rosparam load config/laser_odometry.yaml /laser_odometry
 rosparam set /laser_odometry/queue_size 1000  # process every scan, however slow the tool makes the node
-set +u  # catkin's setup scripts read unset variables
-source "$HGLASM_BUILD/devel/setup.bash"
-set -u
 if [ "$node_tool" = valgrind ]; then
   valgrind --tool=memcheck --leak-check=full --num-callers=30 --log-file="$out/valgrind_node.log" \
     "$bin/laser_odometry_node" __name:=laser_odometry >"$out/node.log" 2>&1 &

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # THE test command: installs what is missing (apt, Debian package names), checks the formatting, builds in
 # Release, and runs every test: core gtests, ROS-layer gtests, rostests on the bags in bags/, the
-# launch-file check, the core tests again under AddressSanitizer + UndefinedBehaviorSanitizer, and a
-# bounded libFuzzer run.
+# launch-file check, the install smoke test (scripts/install_smoke.sh), the core tests again under
+# AddressSanitizer + UndefinedBehaviorSanitizer, and a bounded libFuzzer run.
 # Exits non-zero on any failure. Usage (as root on Debian 12): bash scripts/run_tests.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -27,14 +27,19 @@ hglasm_build --target tests
 echo "== gtest + rostest + launch check (ctest)"
 (cd "$HGLASM_BUILD" && ctest --output-on-failure)
 
-echo "== core tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+echo "== install smoke test: install into a temporary prefix, run the nodelet from the install space"
+bash scripts/install_smoke.sh
+
+echo "== core and evaluation tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 ASAN_BUILD="$HGLASM_ROOT/build-asan"
 if [ ! -f "$ASAN_BUILD/CMakeCache.txt" ]; then
   cmake -S "$HGLASM_ROOT" -B "$ASAN_BUILD" -DHGLASM_CORE_ONLY=ON -DHGLASM_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
 fi
-cmake --build "$ASAN_BUILD" -j"$(nproc)" --target test_core
-ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  "$ASAN_BUILD/test_core" --gtest_brief=1
+cmake --build "$ASAN_BUILD" -j"$(nproc)" --target test_core test_evaluation
+for suite in test_core test_evaluation; do
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    "$ASAN_BUILD/$suite" --gtest_brief=1
+done
 
 if [ -f test/fuzz/fuzz_scan_matcher.cpp ]; then
   echo "== libFuzzer: scan conversion + matching on arbitrary bytes (bounded)"

@@ -24,6 +24,8 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/LaserScan.h>
 
+#include "hglasm_odometry/tools/argument_parser.h"
+
 namespace {
 
 struct Options {
@@ -40,74 +42,53 @@ struct Options {
   rosbag::compression::CompressionType compression = rosbag::compression::BZ2;
 };
 
-void usage() {
-  std::cerr << "usage: cut_bag INPUT.bag OUTPUT.bag [--start SEC] [--duration SEC] [--skip-scans N]\n"
-               "               [--max-scans N] [--relations FILE] [--scan-topic /scan] [--odom-topic /odom]\n"
-               "               [--margin SEC] [--compression bz2|lz4|none]\n";
+const char kUsage[] =
+    "usage: cut_bag INPUT.bag OUTPUT.bag [--start SEC] [--duration SEC] [--skip-scans N]\n"
+    "               [--max-scans N] [--relations FILE] [--scan-topic /scan] [--odom-topic /odom]\n"
+    "               [--margin SEC] [--compression bz2|lz4|none]\n";
+
+bool parseCompression(const std::string& name, rosbag::compression::CompressionType* compression,
+                      std::string* error) {
+  if (name == "bz2") {
+    *compression = rosbag::compression::BZ2;
+  } else if (name == "lz4") {
+    *compression = rosbag::compression::LZ4;
+  } else if (name == "none") {
+    *compression = rosbag::compression::Uncompressed;
+  } else {
+    *error = "unknown compression " + name;
+    return false;
+  }
+  return true;
 }
 
-bool parseArguments(int argc, char** argv, Options* options) {
+/// kOk with *options filled, or what the tool should exit with.
+hglasm_odometry::ArgumentParser::Result parseArguments(int argc, char** argv, Options* options) {
+  using Result = hglasm_odometry::ArgumentParser::Result;
+  hglasm_odometry::ArgumentParser parser("cut_bag", kUsage);
   std::vector<std::string> positional;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](const char* name) -> const char* {
-      if (i + 1 >= argc) {
-        std::cerr << "cut_bag: " << name << " needs a value\n";
-        return nullptr;
-      }
-      return argv[++i];
-    };
-    const char* v = nullptr;
-    if (arg == "--start") {
-      if (!(v = value("--start"))) return false;
-      options->start = std::atof(v);
-    } else if (arg == "--duration") {
-      if (!(v = value("--duration"))) return false;
-      options->duration = std::atof(v);
-    } else if (arg == "--skip-scans") {
-      if (!(v = value("--skip-scans"))) return false;
-      options->skip_scans = std::strtoul(v, nullptr, 10);
-    } else if (arg == "--max-scans") {
-      if (!(v = value("--max-scans"))) return false;
-      options->max_scans = std::strtoul(v, nullptr, 10);
-    } else if (arg == "--relations") {
-      if (!(v = value("--relations"))) return false;
-      options->relations = v;
-    } else if (arg == "--scan-topic") {
-      if (!(v = value("--scan-topic"))) return false;
-      options->scan_topic = v;
-    } else if (arg == "--odom-topic") {
-      if (!(v = value("--odom-topic"))) return false;
-      options->odom_topic = v;
-    } else if (arg == "--margin") {
-      if (!(v = value("--margin"))) return false;
-      options->margin = std::atof(v);
-    } else if (arg == "--compression") {
-      if (!(v = value("--compression"))) return false;
-      const std::string name = v;
-      if (name == "bz2") {
-        options->compression = rosbag::compression::BZ2;
-      } else if (name == "lz4") {
-        options->compression = rosbag::compression::LZ4;
-      } else if (name == "none") {
-        options->compression = rosbag::compression::Uncompressed;
-      } else {
-        std::cerr << "cut_bag: unknown compression " << name << "\n";
-        return false;
-      }
-    } else if (arg == "-h" || arg == "--help") {
-      return false;
-    } else if (!arg.empty() && arg[0] == '-') {
-      std::cerr << "cut_bag: unknown option " << arg << "\n";
-      return false;
-    } else {
-      positional.push_back(arg);
-    }
+  parser.addPositionals(&positional);
+  parser.addOption("--start", &options->start);
+  parser.addOption("--duration", &options->duration);
+  parser.addOption("--skip-scans", &options->skip_scans);
+  parser.addOption("--max-scans", &options->max_scans);
+  parser.addOption("--relations", &options->relations);
+  parser.addOption("--scan-topic", &options->scan_topic);
+  parser.addOption("--odom-topic", &options->odom_topic);
+  parser.addOption("--margin", &options->margin);
+  parser.addOption("--compression", [options](const std::string& name, std::string* error) {
+    return parseCompression(name, &options->compression, error);
+  });
+  const Result result = parser.parse(argc, argv);
+  if (result != Result::kOk) return result;
+  if (positional.size() != 2) {
+    parser.fail("expected two file names, INPUT.bag and OUTPUT.bag; got " +
+                std::to_string(positional.size()));
+    return Result::kError;
   }
-  if (positional.size() != 2) return false;
   options->input = positional[0];
   options->output = positional[1];
-  return true;
+  return Result::kOk;
 }
 
 /// Header stamp of a message on one of the copied topics; bag time when it has none.
@@ -135,10 +116,8 @@ bool matchesStamp(const std::vector<double>& sorted_stamps, double t) {
 
 int main(int argc, char** argv) {
   Options options;
-  if (!parseArguments(argc, argv, &options)) {
-    usage();
-    return 2;
-  }
+  const auto parsed = parseArguments(argc, argv, &options);
+  if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
   try {
     rosbag::Bag input(options.input, rosbag::bagmode::Read);
 

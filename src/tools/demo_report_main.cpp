@@ -24,8 +24,9 @@
 
 #include "hglasm_odometry/Match.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
-#include "hglasm_odometry/core/relations.h"
+#include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/conversions.h"
+#include "hglasm_odometry/tools/argument_parser.h"
 
 namespace {
 
@@ -45,30 +46,24 @@ const char kUsage[] =
     "usage: demo_report --bag B [--relations R] [--output-dir DIR] [--odom-topic T] [--match-topic T]\n"
     "                   [--player /player] [--timeout SEC]\n";
 
-bool parseArguments(const std::vector<std::string>& args, Options* options) {
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    if (i + 1 >= args.size()) return false;
-    const std::string& value = args[++i];
-    if (arg == "--bag") {
-      options->bag = value;
-    } else if (arg == "--relations") {
-      options->relations = value;
-    } else if (arg == "--output-dir") {
-      options->output_dir = value;
-    } else if (arg == "--odom-topic") {
-      options->odom_topic = value;
-    } else if (arg == "--match-topic") {
-      options->match_topic = value;
-    } else if (arg == "--player") {
-      options->player = value;
-    } else if (arg == "--timeout") {
-      options->timeout = std::atof(value.c_str());
-    } else {
-      return false;
-    }
+/// kOk with *options filled, or what the tool should exit with. ROS remappings are gone by now.
+hglasm_odometry::ArgumentParser::Result parseArguments(int argc, char** argv, Options* options) {
+  using Result = hglasm_odometry::ArgumentParser::Result;
+  hglasm_odometry::ArgumentParser parser("demo_report", kUsage);
+  parser.addOption("--bag", &options->bag);
+  parser.addOption("--relations", &options->relations);
+  parser.addOption("--output-dir", &options->output_dir);
+  parser.addOption("--odom-topic", &options->odom_topic);
+  parser.addOption("--match-topic", &options->match_topic);
+  parser.addOption("--player", &options->player);
+  parser.addOption("--timeout", &options->timeout);
+  const Result result = parser.parse(argc, argv);
+  if (result != Result::kOk) return result;
+  if (options->bag.empty()) {
+    parser.fail("--bag is required");
+    return Result::kError;
   }
-  return !options->bag.empty();
+  return Result::kOk;
 }
 
 struct Received {
@@ -96,10 +91,8 @@ void printAccuracyRow(const char* label, const hglasm::RelationStats& laser,
 int main(int argc, char** argv) {
   ros::init(argc, argv, "demo_report", ros::init_options::AnonymousName);
   Options options;
-  if (!parseArguments(std::vector<std::string>(argv + 1, argv + argc), &options)) {
-    std::cerr << kUsage;
-    return 2;
-  }
+  const auto parsed = parseArguments(argc, argv, &options);
+  if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
 
   // The bag: its scan stamps (what must come out) and wheel odometry (for comparison).
   std::vector<double> scan_stamps;

@@ -1,8 +1,6 @@
 // evaluate: runs the nodelet's odometry pipeline (hglasm::OdometryPipeline, same options and YAML)
 // over a bag as fast as the CPU allows, without a ROS master, and scores it on the Kümmerle et al.
 // relations benchmark next to the bag's raw wheel odometry.
-#include <stdio.h>
-#include <stdlib.h>
 #include <time.h>
 
 #include <algorithm>
@@ -17,12 +15,15 @@
 #include <vector>
 
 #include "hglasm_odometry/core/odometry_pipeline.h"
-#include "hglasm_odometry/core/relations.h"
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
-#include "hglasm_odometry/ros/bag_reader.h"
+#include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/parameters.h"
+#include "hglasm_odometry/tools/argument_parser.h"
+#include "hglasm_odometry/tools/bag_reader.h"
+#include "hglasm_odometry/tools/yaml_parameters.h"
 
+#include <ros/package.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 namespace {
@@ -56,7 +57,7 @@ struct Arguments {
   std::string bag;
   std::string scan_topic = "/scan";
   std::string odom_topic = "/odom";
-  std::string config = HGLASM_SOURCE_DIR "/config/laser_odometry.yaml";
+  std::string config;  ///< empty until given or resolved (defaultConfig)
   bool config_given = false;
   std::string presets;
   bool presets_given = false;
@@ -79,133 +80,74 @@ struct Arguments {
   bool quiet = false;
 };
 
-bool parseArguments(int argc, char** argv, Arguments* args) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    const auto value = [&](std::string* out) {
-      if (i + 1 >= argc) {
-        std::cerr << "evaluate: " << flag << " needs a value\n";
-        return false;
-      }
-      *out = argv[++i];
-      return true;
-    };
-    const auto number = [&](double* out) {
-      std::string text;
-      if (!value(&text)) return false;
-      char* end = nullptr;
-      *out = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || *end != '\0' || !std::isfinite(*out)) {
-        std::cerr << "evaluate: " << flag << ": not a number: '" << text << "'\n";
-        return false;
-      }
-      return true;
-    };
-    double parsed = 0.0;
-    if (flag == "--help" || flag == "-h") {
-      std::cout << kUsage;
-      std::exit(0);
-    } else if (flag == "--bag") {
-      if (!value(&args->bag)) return false;
-    } else if (flag == "--scan-topic") {
-      if (!value(&args->scan_topic)) return false;
-    } else if (flag == "--odom-topic") {
-      if (!value(&args->odom_topic)) return false;
-    } else if (flag == "--config") {
-      if (!value(&args->config)) return false;
-      args->config_given = true;
-    } else if (flag == "--presets") {
-      if (!value(&args->presets)) return false;
-      args->presets_given = true;
-    } else if (flag == "--preset") {
-      if (!value(&args->preset)) return false;
-    } else if (flag == "--relations") {
-      if (!value(&args->relations)) return false;
-    } else if (flag == "--out") {
-      if (!value(&args->out)) return false;
-    } else if (flag == "--trace") {
-      if (!value(&args->trace)) return false;
-    } else if (flag == "--plot") {
-      if (!value(&args->plot)) return false;
-    } else if (flag == "--no-odom") {
-      args->use_odometry = false;
-    } else if (flag == "--quiet") {
-      args->quiet = true;
-    } else if (flag == "--direct-pairs") {
-      args->direct_pairs = true;
-    } else if (flag == "--max-scans") {
-      if (!number(&parsed) || parsed < 0) return false;
-      args->max_scans = static_cast<std::size_t>(parsed);
-    } else if (flag == "--angle-increment") {
-      if (!number(&args->angle_increment)) return false;
-      args->override_increment = true;
-    } else if (flag == "--laser-mount") {
-      std::string text;
-      if (!value(&text)) return false;
-      double x = 0.0, y = 0.0, yaw = 0.0;
-      char trailing = 0;
-      if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &x, &y, &yaw, &trailing) != 3 ||
-          !hglasm::Pose2D(x, y, yaw).isFinite()) {
-        std::cerr << "evaluate: --laser-mount expects X,Y,YAW, got '" << text << "'\n";
-        return false;
-      }
-      args->laser_mount = hglasm::Pose2D(x, y, yaw);
-      args->override_mount = true;
-    } else if (flag == "--min-scan-interval") {
-      if (!number(&args->min_scan_interval)) return false;
-    } else if (flag == "--angle-min") {
-      if (!number(&args->angle_min)) return false;
-      args->override_angle_min = true;
-    } else if (flag == "--max-span") {
-      if (!number(&args->short_span)) return false;
-    } else {
-      std::cerr << "evaluate: unknown argument '" << flag << "'\n" << kUsage;
-      return false;
-    }
-  }
-  if (args->bag.empty()) {
-    std::cerr << "evaluate: --bag is required\n" << kUsage;
+/// X,Y,YAW into a pose (metres, metres, radians).
+bool parseLaserMount(const std::string& text, hglasm::Pose2D* mount, std::string* error) {
+  double x = 0.0, y = 0.0, yaw = 0.0;
+  char trailing = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &x, &y, &yaw, &trailing) != 3 ||
+      !hglasm::Pose2D(x, y, yaw).isFinite()) {
+    *error = "expects X,Y,YAW, got '" + text + "'";
     return false;
   }
-  if (args->presets.empty()) {
-    const auto slash = args->config.find_last_of('/');
-    args->presets =
-        (slash == std::string::npos ? std::string() : args->config.substr(0, slash + 1)) + "presets.yaml";
-  }
+  *mount = hglasm::Pose2D(x, y, yaw);
   return true;
 }
 
-/// Loads a YAML file exactly as roslaunch's <rosparam file=...> does: with rosparam's own Python
-/// loader, handed over as XML-RPC (the parameter server's wire format). Needs no master.
-bool loadYaml(const std::string& path, XmlRpc::XmlRpcValue* value, std::string* error) {
-  // The path travels in the environment, so no shell quoting is involved.
-  setenv("HGLASM_EVALUATE_YAML", path.c_str(), 1);
-  const char* command =
-      "/usr/bin/python3 -c 'import os, sys, xmlrpc.client, rosparam\n"
-      "loaded = rosparam.load_file(os.environ[\"HGLASM_EVALUATE_YAML\"])\n"
-      "params = (loaded[0][0] if loaded else None) or {}\n"
-      "sys.stdout.write(xmlrpc.client.dumps((params,), allow_none=True))' 2>&1";
-  FILE* pipe = popen(command, "r");
-  if (!pipe) {
-    *error = "cannot run /usr/bin/python3 to read " + path;
+/// kOk with *args filled, or what the tool should exit with.
+hglasm_odometry::ArgumentParser::Result parseArguments(int argc, char** argv, Arguments* args) {
+  using Result = hglasm_odometry::ArgumentParser::Result;
+  hglasm_odometry::ArgumentParser parser("evaluate", kUsage);
+  parser.addOption("--bag", &args->bag);
+  parser.addOption("--scan-topic", &args->scan_topic);
+  parser.addOption("--odom-topic", &args->odom_topic);
+  parser.addOption("--config", &args->config, &args->config_given);
+  parser.addOption("--presets", &args->presets, &args->presets_given);
+  parser.addOption("--preset", &args->preset);
+  parser.addOption("--relations", &args->relations);
+  parser.addOption("--out", &args->out);
+  parser.addOption("--trace", &args->trace);
+  parser.addOption("--plot", &args->plot);
+  parser.addFlag("--no-odom", &args->use_odometry, false);
+  parser.addFlag("--quiet", &args->quiet);
+  parser.addFlag("--direct-pairs", &args->direct_pairs);
+  parser.addOption("--max-scans", &args->max_scans);
+  parser.addOption("--angle-increment", &args->angle_increment, &args->override_increment);
+  parser.addOption("--angle-min", &args->angle_min, &args->override_angle_min);
+  parser.addOption("--laser-mount", [args](const std::string& text, std::string* error) {
+    args->override_mount = parseLaserMount(text, &args->laser_mount, error);
+    return args->override_mount;
+  });
+  parser.addOption("--min-scan-interval", &args->min_scan_interval);
+  parser.addOption("--max-span", &args->short_span);
+  const Result result = parser.parse(argc, argv);
+  if (result != Result::kOk) return result;
+  if (args->bag.empty()) {
+    parser.fail("--bag is required");
+    return Result::kError;
+  }
+  return Result::kOk;
+}
+
+/// The installed (or devel-space) package's config/laser_odometry.yaml, found as roslaunch finds
+/// $(find hglasm_odometry): through ROS_PACKAGE_PATH, so no source path is compiled in.
+bool defaultConfig(std::string* path, std::string* error) {
+  const std::string package = ros::package::getPath("hglasm_odometry");
+  if (package.empty()) {
+    const char* search_path = std::getenv("ROS_PACKAGE_PATH");
+    *error =
+        "cannot find the package hglasm_odometry for its config/laser_odometry.yaml (ROS_PACKAGE_PATH: " +
+        std::string(search_path ? search_path : "not set") +
+        "): source the workspace's setup.bash, or give --config";
     return false;
   }
-  std::string xml;
-  char buffer[4096];
-  for (std::size_t n; (n = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) xml.append(buffer, n);
-  const int status = pclose(pipe);
-  const auto start = xml.find("<value>");
-  if (status != 0 || start == std::string::npos) {
-    *error = "cannot load " + path + ": " + xml.substr(xml.find_last_of('\n', xml.size() - 2) + 1);
-    return false;
-  }
-  int offset = static_cast<int>(start);
-  *value = XmlRpc::XmlRpcValue(xml, &offset);
-  if (!value->valid() || value->getType() != XmlRpc::XmlRpcValue::TypeStruct) {
-    *error = path + " does not hold a dictionary of parameters";
-    return false;
-  }
+  *path = package + "/config/laser_odometry.yaml";
   return true;
+}
+
+/// presets.yaml in the directory of `config`.
+std::string presetsNextTo(const std::string& config) {
+  const auto slash = config.find_last_of('/');
+  return (slash == std::string::npos ? std::string() : config.substr(0, slash + 1)) + "presets.yaml";
 }
 
 /// The nodelet's private namespace as the launch files build it: presets.yaml under ~presets,
@@ -216,12 +158,12 @@ bool loadNodeletOptions(const Arguments& args, hglasm_odometry::LaserOdometryOpt
   const auto exists = [](const std::string& path) { return std::ifstream(path).good(); };
   XmlRpc::XmlRpcValue root, presets;
   if (args.config_given || exists(args.config)) {
-    if (!loadYaml(args.config, &root, error)) return false;
+    if (!hglasm_odometry::loadYamlParameters(args.config, &root, error)) return false;
   } else {
     std::printf("config        %s not found: built-in defaults\n", args.config.c_str());
   }
   if (args.presets_given || exists(args.presets)) {
-    if (!loadYaml(args.presets, &presets, error)) return false;
+    if (!hglasm_odometry::loadYamlParameters(args.presets, &presets, error)) return false;
     // Accept a presets file written either as {small: ..} or as {presets: {small: ..}}.
     if (presets.size() == 1 && presets.hasMember("presets")) {
       presets = XmlRpc::XmlRpcValue(presets["presets"]);
@@ -665,12 +607,18 @@ void printRelations(const Arguments& args, const std::string& preset_name, const
 
 int main(int argc, char** argv) {
   Arguments args;
-  if (!parseArguments(argc, argv, &args)) return 2;
+  const auto parsed = parseArguments(argc, argv, &args);
+  if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
+  std::string error;
+  if (!args.config_given && !defaultConfig(&args.config, &error)) {
+    std::cerr << "evaluate: " << error << "\n";
+    return 2;
+  }
+  if (args.presets.empty()) args.presets = presetsNextTo(args.config);
 
   // The nodelet's options, through the nodelet's own loader.
   hglasm_odometry::LaserOdometryOptions nodelet_options;
   std::vector<std::string> config_warnings;
-  std::string error;
   if (!loadNodeletOptions(args, &nodelet_options, &config_warnings, &error)) {
     std::cerr << "evaluate: " << error << "\n";
     return 2;

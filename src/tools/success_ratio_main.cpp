@@ -15,11 +15,12 @@
 #include <string>
 #include <vector>
 
-#include "hglasm_odometry/core/carmen_log.h"
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
-#include "hglasm_odometry/core/success_ratio.h"
-#include "hglasm_odometry/ros/bag_reader.h"
+#include "hglasm_odometry/evaluation/carmen_log.h"
+#include "hglasm_odometry/evaluation/success_ratio_report.h"
+#include "hglasm_odometry/tools/argument_parser.h"
+#include "hglasm_odometry/tools/bag_reader.h"
 
 namespace {
 
@@ -73,8 +74,7 @@ struct Arguments {
   std::string topic = "/scan";
   bool topic_given = false;
   std::string carmen;
-  int trials = 0;
-  bool trials_given = false;
+  int trials = 0;  // 0: not given
   std::uint64_t seed = 0;
   bool seed_given = false;
   std::string csv;
@@ -115,130 +115,70 @@ bool parseInteger(const std::string& text, Integer* value) {
   return !text.empty() && result.ec == std::errc() && result.ptr == end;
 }
 
-bool parseFinite(const std::string& text, double* value) {
-  char* end = nullptr;
-  *value = std::strtod(text.c_str(), &end);
-  return !text.empty() && *end == '\0' && std::isfinite(*value);
-}
-
-// Bad arguments: the message and a pointer to the usage.
-bool fail(const std::string& message) {
-  std::cerr << "success_ratio: " << message << "\n(--help for usage)\n";
-  return false;
-}
-
 // Failures after the arguments were accepted (unreadable input, unwritable output).
 bool failRuntime(const std::string& message) {
   std::cerr << "success_ratio: error: " << message << "\n";
   return false;
 }
 
-// Options whose value is kept as given.
-std::string Arguments::*textOption(const std::string& flag) {
-  static const std::pair<const char*, std::string Arguments::*> kTextOptions[] = {
-      {"--bag", &Arguments::bag},
-      {"--carmen", &Arguments::carmen},
-      {"--csv", &Arguments::csv},
-      {"--plots", &Arguments::plots},
-      {"--algorithms", &Arguments::algorithms},
-      {"--presets", &Arguments::presets},
-      {"--cases", &Arguments::cases},
-      {"--curve-generations", &Arguments::curve_generations},
-      {"--curve-csv", &Arguments::curve_csv},
-      {"--curve-algorithms", &Arguments::curve_algorithms},
-      {"--time-csv", &Arguments::time_csv},
-      {"--title", &Arguments::title}};
-  for (const auto& [name, member] : kTextOptions) {
-    if (flag == name) return member;
-  }
-  return nullptr;
+/// The parser filling *args (which must outlive it).
+hglasm_odometry::ArgumentParser makeParser(Arguments* args) {
+  hglasm_odometry::ArgumentParser parser("success_ratio", kUsage);
+  parser.addFlag("--in-box", &args->in_box);
+  parser.addFlag("--quiet", &args->quiet);
+  parser.addFlag("--no-ceiling", &args->ceiling, false);
+  parser.addOption("--bag", &args->bag);
+  parser.addOption("--topic", &args->topic, &args->topic_given);
+  parser.addOption("--carmen", &args->carmen);
+  parser.addOption("--trials", &args->trials, 1);
+  parser.addOption("--seed", &args->seed, std::uint64_t{0}, &args->seed_given);
+  parser.addOption("--csv", &args->csv);
+  parser.addOption("--plots", &args->plots);
+  parser.addOption("--algorithms", &args->algorithms);
+  parser.addOption("--presets", &args->presets);
+  parser.addOption("--cases", &args->cases);
+  parser.addOption("--curve-trials", &args->curve_trials, 0);
+  parser.addOption("--curve-generations", &args->curve_generations);
+  parser.addOption("--curve-csv", &args->curve_csv);
+  parser.addOption("--max-scans", &args->max_scans);
+  parser.addOption("--min-points", &args->min_points, 3);
+  parser.addOption("--angle-min", &args->angle_min, &args->override_angle_min);
+  parser.addOption("--angle-increment", [args](const std::string& text, std::string* error) {
+    char* end = nullptr;
+    args->angle_increment = std::strtod(text.c_str(), &end);
+    args->override_increment =
+        !text.empty() && *end == '\0' && std::isfinite(args->angle_increment) && args->angle_increment != 0.0;
+    if (!args->override_increment) *error = "expected a non-zero number, got '" + text + "'";
+    return args->override_increment;
+  });
+  parser.addOption("--title", &args->title);
+  parser.addOption("--curve-algorithms", &args->curve_algorithms);
+  parser.addOption("--time-csv", &args->time_csv);
+  parser.addOption("--interlace-seconds", &args->interlace_seconds);
+  return parser;
 }
 
-bool parseArguments(int argc, char** argv, Arguments* args) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    std::string text;
-    const auto value = [&]() {
-      if (i + 1 >= argc) return false;
-      text = argv[++i];
-      return true;
-    };
-    const auto needs_value = [&]() { return fail(flag + " needs a value"); };
-    if (flag == "--help" || flag == "-h") {
-      std::cout << kUsage;
-      std::exit(0);
-    } else if (flag == "--in-box") {
-      args->in_box = true;
-    } else if (flag == "--quiet") {
-      args->quiet = true;
-    } else if (flag == "--no-ceiling") {
-      args->ceiling = false;
-    } else if (!value()) {
-      if (flag.rfind("--", 0) != 0) return fail("unexpected argument '" + flag + "'");
-      const bool known = textOption(flag) || flag == "--topic" || flag == "--trials" || flag == "--seed" ||
-                         flag == "--curve-trials" || flag == "--max-scans" || flag == "--min-points" ||
-                         flag == "--angle-min" || flag == "--angle-increment" ||
-                         flag == "--interlace-seconds";
-      return known ? needs_value() : fail("unknown option '" + flag + "'");
-    } else if (std::string Arguments::*member = textOption(flag)) {
-      args->*member = text;
-    } else if (flag == "--topic") {
-      args->topic = text;
-      args->topic_given = true;
-    } else if (flag == "--trials") {
-      if (!parseInteger(text, &args->trials) || args->trials < 1) {
-        return fail("--trials: expected a positive integer, got '" + text + "'");
-      }
-      args->trials_given = true;
-    } else if (flag == "--seed") {
-      if (!parseInteger(text, &args->seed))
-        return fail("--seed: expected an unsigned integer, got '" + text + "'");
-      args->seed_given = true;
-    } else if (flag == "--curve-trials") {
-      if (!parseInteger(text, &args->curve_trials) || args->curve_trials < 0) {
-        return fail("--curve-trials: expected an integer >= 0, got '" + text + "'");
-      }
-    } else if (flag == "--max-scans") {
-      if (!parseInteger(text, &args->max_scans))
-        return fail("--max-scans: expected an integer, got '" + text + "'");
-    } else if (flag == "--min-points") {
-      if (!parseInteger(text, &args->min_points) || args->min_points < 3) {
-        return fail("--min-points: expected an integer >= 3, got '" + text + "'");
-      }
-    } else if (flag == "--angle-min") {
-      if (!parseFinite(text, &args->angle_min)) return fail("--angle-min: not a number: '" + text + "'");
-      args->override_angle_min = true;
-    } else if (flag == "--angle-increment") {
-      if (!parseFinite(text, &args->angle_increment) || args->angle_increment == 0.0) {
-        return fail("--angle-increment: expected a non-zero number, got '" + text + "'");
-      }
-      args->override_increment = true;
-    } else if (flag == "--interlace-seconds") {
-      if (!parseFinite(text, &args->interlace_seconds))
-        return fail("--interlace-seconds: not a number: '" + text + "'");
-    } else {
-      return fail("unknown option '" + flag + "'");
-    }
-  }
-  if (args->bag.empty() == args->carmen.empty())
-    return fail("give exactly one of --bag PATH or --carmen PATH");
-  if (args->topic_given && args->bag.empty()) return fail("--topic applies to --bag only");
-  if (!args->trials_given) return fail("--trials N is required");
-  if (!args->seed_given) return fail("--seed S is required");
-  if (args->csv.empty()) return fail("--csv PATH is required");
-  if (args->interlace_seconds != 0.0 && args->bag.empty())
-    return fail("--interlace-seconds needs --bag (the turn rate comes from its wheel odometry)");
+/// The checks across options, after parsing.
+bool checkArguments(const Arguments& args, const hglasm_odometry::ArgumentParser& parser) {
+  if (args.bag.empty() == args.carmen.empty())
+    return parser.fail("give exactly one of --bag PATH or --carmen PATH");
+  if (args.topic_given && args.bag.empty()) return parser.fail("--topic applies to --bag only");
+  if (args.trials == 0) return parser.fail("--trials N is required");
+  if (!args.seed_given) return parser.fail("--seed S is required");
+  if (args.csv.empty()) return parser.fail("--csv PATH is required");
+  if (args.interlace_seconds != 0.0 && args.bag.empty())
+    return parser.fail("--interlace-seconds needs --bag (the turn rate comes from its wheel odometry)");
   return true;
 }
 
-bool parseAlgorithms(const std::string& flag, const std::string& list,
-                     std::vector<hglasm::Algorithm>* algorithms) {
+bool parseAlgorithms(const hglasm_odometry::ArgumentParser& parser, const std::string& flag,
+                     const std::string& list, std::vector<hglasm::Algorithm>* algorithms) {
   algorithms->clear();
   for (const std::string& name : splitList(list)) {
     hglasm::Algorithm algorithm;
     if (!hglasm::parseAlgorithm(name, &algorithm)) {
-      return fail(flag + ": unknown algorithm '" + name +
-                  "' (hglasm_g, hglasm_binary, glasm_g, glasm_binary, mbicp, pga, hpga)");
+      return parser.fail(flag + ": unknown algorithm '" + name +
+                         "' (hglasm_g, hglasm_binary, glasm_g, glasm_binary, mbicp, pga, hpga)");
     }
     if (std::find(algorithms->begin(), algorithms->end(), algorithm) == algorithms->end())
       algorithms->push_back(algorithm);
@@ -246,33 +186,36 @@ bool parseAlgorithms(const std::string& flag, const std::string& list,
   return true;
 }
 
-bool buildOptions(const Arguments& args, hglasm::SuccessRatioOptions* options) {
-  if (!parseAlgorithms("--algorithms", args.algorithms, &options->algorithms)) return false;
-  if (!parseAlgorithms("--curve-algorithms", args.curve_algorithms, &options->curve_algorithms)) return false;
+bool buildOptions(const Arguments& args, const hglasm_odometry::ArgumentParser& parser,
+                  hglasm::SuccessRatioOptions* options) {
+  if (!parseAlgorithms(parser, "--algorithms", args.algorithms, &options->algorithms)) return false;
+  if (!parseAlgorithms(parser, "--curve-algorithms", args.curve_algorithms, &options->curve_algorithms))
+    return false;
   for (hglasm::Algorithm algorithm : options->curve_algorithms) {
     if (hglasm::usesMbicpStage(algorithm) || !hglasm::usesGeneticStage(algorithm))
-      return fail("--curve-algorithms: the curves are of GA-alone algorithms (glasm_g, glasm_binary, pga)");
+      return parser.fail(
+          "--curve-algorithms: the curves are of GA-alone algorithms (glasm_g, glasm_binary, pga)");
   }
   options->ceiling = args.ceiling;
   for (const std::string& name : splitList(args.presets)) {
     hglasm::Preset preset;
     if (!hglasm::parsePreset(name, &preset))
-      return fail("unknown preset '" + name + "' (small, medium, large)");
+      return parser.fail("unknown preset '" + name + "' (small, medium, large)");
     if (std::find(options->presets.begin(), options->presets.end(), preset) == options->presets.end()) {
       options->presets.push_back(preset);
     }
   }
-  if (options->algorithms.empty()) return fail("--algorithms: empty list");
-  if (options->presets.empty()) return fail("--presets: empty list");
+  if (options->algorithms.empty()) return parser.fail("--algorithms: empty list");
+  if (options->presets.empty()) return parser.fail("--presets: empty list");
   std::string error;
-  if (!hglasm::parseCases(args.cases, &options->cases, &error)) return fail("--cases: " + error);
+  if (!hglasm::parseCases(args.cases, &options->cases, &error)) return parser.fail("--cases: " + error);
   if (options->cases.empty() && !args.in_box && args.curve_trials == 0) {
-    return fail("nothing to run: --cases none without --in-box and with --curve-trials 0");
+    return parser.fail("nothing to run: --cases none without --in-box and with --curve-trials 0");
   }
   for (const std::string& item : splitList(args.curve_generations)) {
     int generations = 0;
     if (!parseInteger(item, &generations) || generations < 1) {
-      return fail("--curve-generations: expected positive integers, got '" + item + "'");
+      return parser.fail("--curve-generations: expected positive integers, got '" + item + "'");
     }
     options->curve_generations.push_back(generations);
   }
@@ -390,9 +333,12 @@ bool writePlots(const hglasm::SuccessRatioReport& report, const Arguments& args)
 
 int main(int argc, char** argv) {
   Arguments args;
-  if (!parseArguments(argc, argv, &args)) return kExitBadArguments;
+  const hglasm_odometry::ArgumentParser parser = makeParser(&args);
+  const auto parsed = parser.parse(argc, argv);
+  if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
+  if (!checkArguments(args, parser)) return kExitBadArguments;
   hglasm::SuccessRatioOptions options;
-  if (!buildOptions(args, &options)) return kExitBadArguments;
+  if (!buildOptions(args, parser, &options)) return kExitBadArguments;
 
   // Fail on unwritable outputs now, not after a long run.
   if (!std::ofstream(args.csv, std::ios::app)) {

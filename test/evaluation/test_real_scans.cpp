@@ -9,9 +9,9 @@
 #include <random>
 #include <sstream>
 
-#include "hglasm_odometry/core/carmen_log.h"
+#include "../core/test_util.h"
 #include "hglasm_odometry/core/scan_matcher.h"
-#include "test_util.h"
+#include "hglasm_odometry/evaluation/carmen_log.h"
 
 namespace {
 

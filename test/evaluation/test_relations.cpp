@@ -1,5 +1,5 @@
 // The relations metric on synthetic trajectories with known answers, and the relations file reader.
-#include "hglasm_odometry/core/relations.h"
+#include "hglasm_odometry/evaluation/relations.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Cholesky>

@@ -1,5 +1,5 @@
 // The Kümmerle et al. 2009 relations metric.
-#include "hglasm_odometry/core/relations.h"
+#include "hglasm_odometry/evaluation/relations.h"
 
 #include <Eigen/Cholesky>
 #include <algorithm>

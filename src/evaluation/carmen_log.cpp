@@ -1,4 +1,4 @@
-#include "hglasm_odometry/core/carmen_log.h"
+#include "hglasm_odometry/evaluation/carmen_log.h"
 
 #include <cctype>
 #include <charconv>

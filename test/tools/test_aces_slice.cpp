@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "hglasm_odometry/core/odometry_pipeline.h"
-#include "hglasm_odometry/core/relations.h"
-#include "hglasm_odometry/ros/bag_reader.h"
+#include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/parameters.h"
+#include "hglasm_odometry/tools/bag_reader.h"
 
 namespace hglasm_odometry {
 namespace {

@@ -1,5 +1,5 @@
 // The CARMEN FLASER parser: synthetic lines with known contents, malformed lines, and the real laserazos log.
-#include "hglasm_odometry/core/carmen_log.h"
+#include "hglasm_odometry/evaluation/carmen_log.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <sstream>
 #include <string>
 
+#include "../core/test_util.h"
 #include "hglasm_odometry/core/scan.h"
-#include "test_util.h"
 
 namespace hglasm {
 namespace {

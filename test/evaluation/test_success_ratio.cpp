@@ -1,5 +1,6 @@
-// The Success-Ratio protocol on simulated scans, where every answer is known exactly.
-#include "hglasm_odometry/core/success_ratio.h"
+// The Success-Ratio protocol and its CSV / plot output on simulated scans, where every answer is known
+// exactly.
+#include "hglasm_odometry/evaluation/success_ratio_report.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "test_util.h"
+#include "../core/test_util.h"
 
 namespace hglasm {
 namespace {
