@@ -224,6 +224,11 @@ PreAlignResult GeneticAligner::align(const FitnessStages& stages, const Pose2D& 
       }
       population.swap(offspring);
     }
+    if (scoring != &stages.fine) {
+      // Every generation was coarse: rescore on the fine fitness, the one the guess and the polish use.
+      scoring = &stages.fine;
+      for (auto& individual : population) evaluate(individual);
+    }
     const auto best =
         std::max_element(population.begin(), population.end(),
                          [](const Individual& a, const Individual& b) { return a.fitness < b.fitness; });
