@@ -113,14 +113,14 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
 
   scan_sub_ = nh_.subscribe("scan", kScanSubscriberQueue, &LaserOdometry::scanCallback, this,
                             ros::TransportHints().tcpNoDelay());
-  if (options_.use_odom) {
+  if (options_.tracker.use_odometry) {
     odom_sub_ = nh_.subscribe("odom", kOdomSubscriberQueue, &LaserOdometry::odomCallback, this,
                               ros::TransportHints().tcpNoDelay());
   }
-  ROS_INFO_STREAM(
-      "[" << name_ << "] laser odometry on " << scan_sub_.getTopic()
-          << (options_.use_odom ? " + " + odom_sub_.getTopic() : std::string(" (no wheel odometry)")) << ": "
-          << summarize(options_));
+  ROS_INFO_STREAM("[" << name_ << "] laser odometry on " << scan_sub_.getTopic()
+                      << (options_.tracker.use_odometry ? " + " + odom_sub_.getTopic()
+                                                        : std::string(" (no wheel odometry)"))
+                      << ": " << summarize(options_));
 }
 
 LaserOdometry::~LaserOdometry() {
