@@ -87,39 +87,16 @@ bool parsePreset(const std::string& name, Preset* preset) {
 }
 
 MatcherOptions presetOptions(Preset preset) {
-  // Box and GA size exactly as the papers' Table 1; the rest measured with the success_ratio tool on
-  // intel and fr079 (see README): 4 cm cells cost no success and halve the table build; strong selection
-  // (tournament of 6, 4 elites) with 10 % bit mutation and a coarse first stage find the true pose more
-  // often than the textbook 2-tournament / 3 %.
+  // The defaults of MatcherOptions are the medium preset; the papers' Table 1 grows box and GA together.
   MatcherOptions options;
-  options.table = LookupTableOptions{TableKind::kGraded, 0.04, 0.10, 0.30, 0.30, 0.10};
-  options.coarse_table = LookupTableOptions{TableKind::kGraded, 0.08, 0.30, 0.60, 0.30, 0.10};
-  options.genetic.tournament_size = 6;
-  options.genetic.elite_count = 4;
-  options.genetic.mutation_rate = 0.10;
-  options.genetic.crossover_rate = 0.8;
-  options.genetic.polish_evaluations = 60;
-  // Measured with the evaluate tool on fr079 (all relations: rotation drift 4.3 -> 2.9 deg): once the
-  // estimate settles, a 15 cm gate and 10 % trimming keep moved objects and unmatched structure out.
-  options.mbicp.max_distance = 0.30;
-  options.mbicp.fine_max_distance = 0.15;
-  options.mbicp.trim_fraction = 0.90;
-  // Measured against the relations of intel, fr079 and aces (README): with 50 the fused odometry leans on
-  // the wheels where the scans know better, with 200 it takes the scans' look-alike leaps.
-  options.mbicp.independent_points = 100.0;
   switch (preset) {
     case Preset::kSmall:
       options.genetic.box = {0.3, 0.3, 0.3};
       options.genetic.population = 20;
       options.genetic.generations = 6;
-      options.genetic.runs = 1;
+      options.genetic.coarse_generations = 0;
       break;
     case Preset::kMedium:
-      options.genetic.box = {1.0, 1.0, 1.0};
-      options.genetic.population = 100;
-      options.genetic.generations = 10;
-      options.genetic.runs = 1;
-      options.genetic.coarse_generations = 3;
       break;
     case Preset::kLarge:
       options.genetic.box = {2.0, 2.0, M_PI};
