@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -101,8 +102,27 @@ const char* toString(PredictionSource source) {
   return "unknown";
 }
 
+namespace {
+
+/// Whether the matcher's fine table is the graded one that scans are judged on.
+bool matcherHasGradedTable(Algorithm algorithm) {
+  return algorithm == Algorithm::kHglasmG || algorithm == Algorithm::kGlasmG;
+}
+
+double millisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
 OdometryTracker::OdometryTracker(const TrackerOptions& options)
-    : options_(options), matcher_(options.matcher), noise_(options.motion), local_map_(options.local_map) {}
+    : options_(options), matcher_(options.matcher), noise_(options.motion), local_map_(options.local_map) {
+  if (!matcherHasGradedTable(options_.matcher.algorithm)) {
+    LookupTableOptions graded = options_.matcher.table;
+    graded.kind = TableKind::kGraded;
+    own_table_.emplace(graded);
+  }
+}
 
 void OdometryTracker::setLaserMount(const Pose2D& base_to_laser) {
   if (base_to_laser.isFinite()) laser_mount_ = base_to_laser;
@@ -197,7 +217,7 @@ OdometryTracker::Candidate OdometryTracker::evaluate(const Scan& scan, const Mat
   candidate.match = match;
   const Eigen::Vector3d offset = poseDifference(match.pose, prior.mean);
   candidate.mahalanobis_sq = match.pose.isFinite() ? offset.dot(prior.information * offset) : 0.0;
-  candidate.fitness_ratio = match.pose.isFinite() ? matcher_.fitnessRatioAt(scan, match.pose) : 0.0;
+  candidate.fitness_ratio = match.pose.isFinite() ? fitnessRatioAt(scan, match.pose) : 0.0;
   candidate.acceptable = matchUsable(match) && candidate.fitness_ratio >= options_.min_fitness;
   return candidate;
 }
@@ -233,7 +253,18 @@ double OdometryTracker::scanLogLikelihood(const Scan& scan, const Pose2D& pose) 
   const double independent = options_.matcher.mbicp.independent_points;
   const double weight =
       independent > 0.0 ? std::min(1.0, independent / std::max<double>(1.0, scan.size())) : 1.0;
-  return weight * matcher_.logLikelihoodAt(scan, pose, options_.likelihood_outlier);
+  const LookupTable& table = judgingTable();
+  if (table.empty() || scan.empty()) return 0.0;
+  FitnessPoints points;
+  points.assign(scan.points);
+  return weight * table.logLikelihood(points, pose, options_.likelihood_outlier);
+}
+
+double OdometryTracker::fitnessRatioAt(const Scan& scan, const Pose2D& pose) const {
+  const LookupTable& table = judgingTable();
+  if (table.empty() || scan.empty()) return 0.0;
+  const double best = static_cast<double>(table.maxCellValue()) * static_cast<double>(scan.size());
+  return table.fitness(scan.points, pose) / best;
 }
 
 double OdometryTracker::logPrior(const Pose2D& pose, const PosePrior& prior,
@@ -440,7 +471,7 @@ void OdometryTracker::initialise(double stamp, const Scan& scan, bool usable, Tr
   if (usable) {
     addKeyframe(scan);
     update->new_keyframe = true;
-    update->table_build_ms = matcher_.lastTableBuildMs();
+    update->table_build_ms = table_build_ms_;
   }
   update->keyframe_id = keyframe_id_;
 }
@@ -471,6 +502,12 @@ void OdometryTracker::addKeyframe(const Scan& scan) {
   const Pose2D old_frame = local_map_.frame();
   local_map_.add(pose_ * laser_mount_, scan.points);
   matcher_.setReference(local_map_.reference());
+  table_build_ms_ = matcher_.lastTableBuildMs();
+  if (own_table_) {
+    const auto start = std::chrono::steady_clock::now();
+    own_table_->build(local_map_.reference());
+    table_build_ms_ += millisecondsSince(start);
+  }
   // The pose's uncertainty relative to the map stays; only the frame it is expressed in turns.
   map_covariance_ = had_map ? rotateCovariance(relativePose(local_map_.frame(), old_frame), map_covariance_)
                             : Eigen::Matrix3d::Zero();
@@ -498,7 +535,7 @@ void OdometryTracker::updateKeyframe(const Scan& scan, bool usable, TrackerUpdat
   if (wants_keyframe && usable) {
     addKeyframe(scan);
     update->new_keyframe = true;
-    update->table_build_ms = matcher_.lastTableBuildMs();
+    update->table_build_ms = table_build_ms_;
   }
 }
 
@@ -548,6 +585,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
     have_scan_only_pose_ = false;
     update.fallback = true;  // nothing (convincing) to match: keep the motion predicted
     estimate = integratePrediction(prediction);
+    if (usable) update.fitness_ratio = fitnessRatioAt(scan, estimate.laser_in_map);
   }
   const Pose2D new_pose = fromMap(estimate.laser_in_map);
   // What the models leave out (timing, the scans' distortion, the surfaces' own errors) grows with time:

@@ -203,8 +203,8 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
     }
     result.prealign_ms = millisecondsSince(start);
     result.prealigned_pose = result.pose = prealigned.pose;
-    result.fitness = prealigned.fitness;
-    result.fitness_ratio = prealigned.fitness_ratio;
+    result.prealigned_fitness = prealigned.fitness;
+    result.prealigned_fitness_ratio = prealigned.fitness_ratio;
     result.evaluations = prealigned.evaluations;
     if (!usesMbicpStage(options_.algorithm)) {
       result.status = prealigned.fitness > 0 ? MatchStatus::kOk : MatchStatus::kLowFitness;
@@ -216,10 +216,6 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
   }
 
   refineInto(scan, prior, &result);
-  if (!usesGeneticStage(options_.algorithm) && table_.empty()) {
-    // MbICP alone: report the fraction of points associated as the quality ratio.
-    result.fitness_ratio = static_cast<double>(result.associations) / static_cast<double>(scan.size());
-  }
   return result;
 }
 
@@ -254,7 +250,6 @@ MatchResult ScanMatcher::refine(const Scan& scan, const Pose2D& guess, const Pos
   MatchResult result;
   if (!startResult(scan, guess, &result)) return result;
   refineInto(scan, prior, &result);
-  result.fitness_ratio = fitnessRatioAt(scan, result.pose);
   return result;
 }
 

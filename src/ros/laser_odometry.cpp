@@ -430,8 +430,9 @@ void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::Pip
     match.prealigned_pose = pose2DMsgFromPose2D(update.match.prealigned_pose);
     match.final_pose = pose2DMsgFromPose2D(update.match.pose);
   }
-  match.fitness = update.match.fitness;
-  match.fitness_ratio = finiteFloat(update.match.fitness_ratio);
+  match.fitness_ratio = finiteFloat(update.fitness_ratio);
+  match.prealigned_fitness = update.match.prealigned_fitness;
+  match.prealigned_fitness_ratio = finiteFloat(update.match.prealigned_fitness_ratio);
   match.evaluations = static_cast<std::uint32_t>(std::max(0, update.match.evaluations));
   match.iterations = static_cast<std::uint32_t>(std::max(0, update.match.iterations));
   match.associations = static_cast<std::uint32_t>(std::max(0, update.match.associations));

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,8 +25,8 @@ struct TrackerOptions {
   MotionNoiseOptions motion;
   double keyframe_distance = 0.30;    ///< metres moved since the keyframe that make a new keyframe
   double keyframe_angle = 0.20;       ///< radians turned since the keyframe that make a new keyframe
-  double keyframe_min_fitness = 0.0;  ///< a match below this fitness ratio makes the scan a keyframe
-  double min_fitness = 0.15;          ///< a match whose pose scores below this fitness ratio has failed
+  double keyframe_min_fitness = 0.0;  ///< a published pose below this fitness ratio makes the scan a keyframe
+  double min_fitness = 0.15;          ///< a match whose pose is below this fitness ratio has failed
   int min_points = 20;                ///< scans with fewer valid points are not matched
   double fallback_covariance_scale = 100.0;  ///< covariance inflation of a step whose match failed
   double odometry_max_extrapolation = 0.25;  ///< seconds; beyond, wheel odometry counts as stale
@@ -88,9 +89,13 @@ struct TrackerUpdate {
   /// Unknown (kUnknownVariance on the diagonal) until the velocity has a baseline: the first scans, after
   /// a reset.
   Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Identity() * kUnknownVariance;
-  MatchResult match;           ///< raw matcher output (laser frame, local map's frame)
-  double fitness_ratio = 0.0;  ///< fitness ratio of the scan at the estimated pose (fine table)
-  Pose2D guess;                ///< predicted pose of the base (odometry frame) before matching
+  MatchResult match;  ///< raw matcher output (laser frame, local map's frame)
+  /// How well the scan fits the local map at the published pose: the cells its points hit on the fine
+  /// graded table / (255 * points), 1 = every point on the map; whatever the algorithm, the ratio
+  /// min_fitness, keyframe_min_fitness and the doubt about the prediction judge. 0 without a map or a usable
+  /// scan.
+  double fitness_ratio = 0.0;
+  Pose2D guess;  ///< predicted pose of the base (odometry frame) before matching
   PredictionSource prediction = PredictionSource::kNone;
   SearchEffort search;              ///< box and GA size the scan was searched with
   double prior_mahalanobis = 0.0;   ///< Mahalanobis distance of the match from the prediction
@@ -194,8 +199,14 @@ class OdometryTracker {
   /// Whether the tight match (or the scan alone) disagrees with the prediction beyond its noise.
   bool predictionInDoubt(const Candidate& tight, const PosePrior& prior,
                          const Eigen::Matrix3d& prior_covariance) const;
-  /// log p(scan | pose), of the scan's independent points (on the lookup table as a likelihood field).
+  /// log p(scan | pose), of the scan's independent points (on the judging table as a likelihood field).
   double scanLogLikelihood(const Scan& scan, const Pose2D& pose) const;
+  /// The fitness ratio of `scan` at `pose` (local map's frame) on the judging table.
+  double fitnessRatioAt(const Scan& scan, const Pose2D& pose) const;
+  /// The fine graded table of the local map that scans are judged on: the matcher's own where it is one
+  /// (hglasm_g, glasm_g), else own_table_ (binary tables, MbICP and PGA alone have none), so that one
+  /// yardstick judges every algorithm.
+  const LookupTable& judgingTable() const { return own_table_ ? *own_table_ : matcher_.table(); }
   /// log of the normal density of `pose` under a prior.
   static double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3d& covariance);
   /// Learns the wheels' noise from the wheel increment against the scans' own increment.
@@ -210,6 +221,8 @@ class OdometryTracker {
 
   TrackerOptions options_;
   ScanMatcher matcher_;
+  std::optional<LookupTable> own_table_;  // see judgingTable()
+  double table_build_ms_ = 0.0;           // of the tables of the newest keyframe's map
   OdometryBuffer odometry_;
   MotionNoiseModel noise_;
   LocalMap local_map_;

@@ -76,10 +76,13 @@ struct MatchResult {
   Pose2D pose;             ///< new scan in the reference frame (final)
   Pose2D prealigned_pose;  ///< after the GA (the guess when there is no GA stage)
   MatchStatus status = MatchStatus::kNoReference;
-  std::uint32_t fitness = 0;   ///< GA fitness of prealigned_pose
-  double fitness_ratio = 0.0;  ///< fitness / (max cell * points), in [0, 1]
-  int evaluations = 0;         ///< GA fitness evaluations
-  int iterations = 0;          ///< MbICP iterations
+  /// The GA's own fitness of prealigned_pose (its lookup table's cells, or PGA's pairing score; 0 without a
+  /// GA stage). How well the final pose fits is the caller's to judge (OdometryTracker: on the fine table).
+  std::uint32_t prealigned_fitness = 0;
+  double prealigned_fitness_ratio =
+      0.0;              ///< prealigned_fitness / its value with every point on the reference
+  int evaluations = 0;  ///< GA fitness evaluations
+  int iterations = 0;   ///< MbICP iterations
   int associations = 0;
   double rms_error = 0.0;  ///< MbICP residual, metres
   MbicpStatus mbicp_status = MbicpStatus::kConverged;
