@@ -9,10 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "hglasm_odometry/core/keyframe_policy.h"
 #include "hglasm_odometry/core/local_map.h"
 #include "hglasm_odometry/core/motion_model.h"
-#include "hglasm_odometry/core/odometry_buffer.h"
 #include "hglasm_odometry/core/pose2d.h"
+#include "hglasm_odometry/core/pose_extrapolator.h"
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
 
@@ -73,9 +74,6 @@ struct TrackerOptions {
 /// The variance published for what is not known (a covariance must stay finite).
 constexpr double kUnknownVariance = 1e4;
 
-enum class PredictionSource { kOdometry, kConstantVelocity, kNone };
-const char* toString(PredictionSource source);
-
 /// What happened to one scan.
 struct TrackerUpdate {
   double stamp = 0.0;
@@ -132,7 +130,7 @@ class OdometryTracker {
   TrackerUpdate processScan(double stamp, const Scan& scan, std::vector<Pose2D>* population_out = nullptr);
 
   /// Makes the next processed scan a keyframe (e.g. the scanner's geometry changed).
-  void requestKeyframe() { keyframe_requested_ = true; }
+  void requestKeyframe() { keyframes_.request(); }
 
   /// Restarts from the identity pose with an empty map (odometry history and learned noise kept).
   void reset();
@@ -143,13 +141,6 @@ class OdometryTracker {
   const LocalMap& localMap() const { return local_map_; }
 
  private:
-  /// The predicted motion of the base since the last scan, in the base frame, and its noise.
-  struct Prediction {
-    PredictionSource source = PredictionSource::kNone;
-    Pose2D motion;
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-    Eigen::Matrix3d nominal_covariance = Eigen::Matrix3d::Zero();  ///< wheels at unit noise scale
-  };
   /// The new pose: the laser in the local map's frame, with its covariance there, and the covariance of
   /// the base's increment since the last scan.
   struct Estimate {
@@ -180,7 +171,7 @@ class OdometryTracker {
   };
 
   bool handleTime(double stamp, TrackerUpdate* update);
-  Hypotheses hypothesesFor(const Prediction& prediction) const;
+  Hypotheses hypothesesFor(const MotionPrediction& prediction) const;
   /// log posterior of a match under each hypothesis (up to a common constant).
   void scoreHypotheses(const Scan& scan, const Hypotheses& h, const MatchResult& match, double* holds,
                        double* wrong) const;
@@ -190,9 +181,8 @@ class OdometryTracker {
   /// The new pose and its covariances from the chosen match.
   void estimateFrom(const Candidate& chosen, const Hypotheses& h, Estimate* estimate) const;
   void initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update);
-  Prediction predict(double stamp, std::string* warning) const;
   /// Match against the local map with the prediction as prior; false if the prediction is integrated.
-  bool matchScan(const Scan& scan, const Prediction& prediction, std::vector<Pose2D>* population_out,
+  bool matchScan(const Scan& scan, const MotionPrediction& prediction, std::vector<Pose2D>* population_out,
                  TrackerUpdate* update, Estimate* estimate);
   SearchEffort searchEffort(const Eigen::Matrix3d& prior_covariance, bool have_prior) const;
   Candidate evaluate(const Scan& scan, const MatchResult& match, const PosePrior& prior) const;
@@ -210,8 +200,8 @@ class OdometryTracker {
   /// log of the normal density of `pose` under a prior.
   static double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3d& covariance);
   /// Learns the wheels' noise from the wheel increment against the scans' own increment.
-  void learnNoise(const Prediction& prediction, const MatchResult& match);
-  Estimate integratePrediction(const Prediction& prediction) const;
+  void learnNoise(const MotionPrediction& prediction, const MatchResult& match);
+  Estimate integratePrediction(const MotionPrediction& prediction) const;
   void updateVelocity(double stamp, const Pose2D& new_pose, TrackerUpdate* update);
   void updateKeyframe(const Scan& scan, bool usable, TrackerUpdate* update);
   void addKeyframe(const Scan& scan);
@@ -223,7 +213,8 @@ class OdometryTracker {
   ScanMatcher matcher_;
   std::optional<LookupTable> own_table_;  // see judgingTable()
   double table_build_ms_ = 0.0;           // of the tables of the newest keyframe's map
-  OdometryBuffer odometry_;
+  PoseExtrapolator extrapolator_;
+  KeyframePolicy keyframes_;
   MotionNoiseModel noise_;
   LocalMap local_map_;
   Pose2D laser_mount_;
@@ -233,8 +224,6 @@ class OdometryTracker {
   Pose2D pose_;
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d map_covariance_ = Eigen::Matrix3d::Zero();  // of the laser pose in the local map's frame
-  Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
-  bool velocity_valid_ = false;
   double prediction_wrong_ = 0.0;  // probability that the last scan's prediction was wrong (a leap)
   /// Mean and variance of recent values, exponentially forgotten.
   struct RunningStats {
@@ -247,11 +236,7 @@ class OdometryTracker {
   bool have_scan_only_pose_ = false;
   Pose2D scan_only_pose_;  // base pose in the odometry frame where the last scan alone put it
 
-  std::deque<StampedPose> history_;  // recent poses, for the velocity
-  bool keyframe_requested_ = false;
   int keyframe_id_ = 0;
-  int keyframe_beam_count_ = 0;
-  Pose2D keyframe_pose_;  // base pose of the newest keyframe
 };
 
 }  // namespace hglasm
