@@ -30,6 +30,7 @@
 #   -s  trials per sweep cell (default 200; 0 skips the sweep; -s 500 gives every cell 500 trials)
 #   -c  trials per point of the fitness-evaluation curves (default 500)
 #   -S  seed (default 1)
+#   -R  report only: print the summary of the outputs already in OUT_DIR (no runs)
 set -euo pipefail
 
 package_dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -47,8 +48,9 @@ sweep_trials=200
 curve_trials=500
 seed=1
 
-usage() { sed -n '2,34p' "$0" | sed 's/^# \{0,1\}//'; }
-while getopts "e:b:d:o:l:n:s:c:S:h" option; do
+usage() { sed -n '2,35p' "$0" | sed 's/^# \{0,1\}//'; }
+report_only=0
+while getopts "e:b:d:o:l:n:s:c:S:Rh" option; do
   case "$option" in
     e) binary="$OPTARG" ;;
     b) build_dir="$OPTARG" ;;
@@ -59,6 +61,7 @@ while getopts "e:b:d:o:l:n:s:c:S:h" option; do
     s) sweep_trials="$OPTARG" ;;
     c) curve_trials="$OPTARG" ;;
     S) seed="$OPTARG" ;;
+    R) report_only=1 ;;
     h) usage; exit 0 ;;
     *) usage >&2; exit 2 ;;
   esac
@@ -68,7 +71,9 @@ for number in "$headline_trials" "$sweep_trials" "$curve_trials" "$seed"; do
 done
 ((headline_trials > 0)) || { echo "success_ratio_experiments: -n must be positive" >&2; exit 2; }
 
-if [[ -z "$binary" ]]; then
+if ((report_only)); then
+  binary=true  # nothing runs
+elif [[ -z "$binary" ]]; then
   if [[ ! -f "$build_dir/CMakeCache.txt" ]]; then
     echo "== configuring $build_dir" >&2
     cmake -S "$package_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release \
@@ -80,7 +85,7 @@ if [[ -z "$binary" ]]; then
   devel="$(sed -n 's/^CATKIN_DEVEL_PREFIX:[A-Z]*=//p' "$build_dir/CMakeCache.txt")"
   binary="${devel:-$build_dir/devel}/lib/hglasm_odometry/success_ratio"
 fi
-[[ -x "$binary" ]] || { echo "success_ratio_experiments: no success_ratio binary at '$binary'" >&2; exit 2; }
+((report_only)) || [[ -x "$binary" ]] || { echo "success_ratio_experiments: no success_ratio binary at '$binary'" >&2; exit 2; }
 
 input=()
 set_input() {  # sets `input` to the input flags of one log
@@ -98,7 +103,9 @@ for log in $logs; do set_input "$log"; done
 mkdir -p "$out_dir"
 start_all=$SECONDS
 timings=""
+((report_only)) && timings="nothing run (-R: the summary of earlier outputs)"$'\n'
 for log in $logs; do
+  ((report_only)) && break
   set_input "$log"
   dir="$out_dir/$log"
   mkdir -p "$dir/plots"
@@ -132,16 +139,43 @@ summary() {
   echo "0.30 m and 0.1 rad for the GA alone: glasm_g, glasm_binary, pga). ms = mean wall time per match,"
   echo "reference preparation (lookup tables; PGA: the angular sort) included, one thread. ceiling = success"
   echo "of the same algorithm and preset at zero initial error (the halves matched from the identity)."
+  echo
+  echo "== all logs: success at 20 deg + 0.57 m / in the preset's whole box / ceiling (zero initial error)"
+  files=()
+  for log in $logs; do files+=("$out_dir/$log/headline.csv"); done
+  awk -F, -v logs="$logs" 'FNR == 1 { ++file; next }
+    {
+      key = $1 " " $2; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
+      cell = ($3 == "box") ? "box" : "head"
+      value[key, file, cell] = sprintf("%5.1f", 100 * $7)
+      value[key, file, "ceiling"] = ($11 == "") ? "  -" : sprintf("%5.1f", 100 * $11)
+    }
+    END {
+      count = split(logs, name, " ")
+      printf "%-21s", "algorithm preset"
+      for (f = 1; f <= count; ++f) printf " | %-19s", name[f] " 20/0.57 box ceil"
+      printf "\n"
+      for (i = 1; i <= n; ++i) {
+        printf "%-21s", order[i]
+        for (f = 1; f <= count; ++f)
+          printf " | %5s %5s %5s    ", value[order[i], f, "head"], value[order[i], f, "box"], value[order[i], f, "ceiling"]
+        printf "\n"
+      }
+    }' "${files[@]}"
   for log in $logs; do
     dir="$out_dir/$log"
     echo
     echo "== $log: 20 deg + 0.57 m and in-box (errors uniform in the preset's box), $headline_trials trials per cell"
     interlace="$dir/ceiling_interlace.csv"
-    [[ -f "$interlace" && "$log" == fr079 ]] || interlace=/dev/null
-    # The interlace file is told apart by name: /dev/null has no header line to count files by.
-    awk -F, -v interlace_file="$interlace" 'FNR == 1 { next }
-      FILENAME == interlace_file { ceiling_interlace[$1 " " $2] = sprintf("%5.1f%%", 100 * $7); next }
-      {
+    [[ -f "$interlace" && "$log" == fr079 ]] || interlace=""
+    awk -F, -v interlace="$interlace" 'BEGIN {
+        while ((getline line < interlace) > 0) {
+          if (++lines == 1) continue
+          split(line, field, ",")
+          ceiling_interlace[field[1] " " field[2]] = sprintf("%5.1f%%", 100 * field[7])
+        }
+      }
+      NR > 1 {
         key = $1 " " $2; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
         cell = ($3 == "box") ? "box" : "head"
         text[key, cell] = sprintf("%5.1f%% %6.3f %6.2f %7.2f", 100 * $7, $8, $9, $10)
@@ -156,7 +190,7 @@ summary() {
           if (has_interlace) printf "  %s", ceiling_interlace[order[i]]
           printf "\n"
         }
-      }' "$interlace" "$dir/headline.csv"
+      }' "$dir/headline.csv"
     if [[ -f "$dir/headline_evaluations.csv" ]]; then
       echo
       echo "-- $log: GA alone, pre-alignment success and median errors vs fitness evaluations (errors uniform in the box, $curve_trials trials)"

@@ -927,7 +927,7 @@ bool writeTimeToReachPlot(const SuccessRatioReport& report, const std::string& d
                    "generations reaching it; no bar: not reached)") +
       "\nset style data histogram\nset style histogram clustered gap 1\nset style fill solid 0.85 "
       "border -1\nset datafile missing '?'\nset logscale y\nset grid ytics\nset yrange [0.01:*]\n"
-      "set key top left\nset xlabel 'success ratio reached'\nset ylabel 'ms per match (log)'\n";
+      "set key above horizontal\nset xlabel 'success ratio reached'\nset ylabel 'ms per match (log)'\n";
   for (std::size_t p = 0; p < presets.size(); ++p) {
     for (int included = 0; included < 2; ++included) {
       script += "set title " +

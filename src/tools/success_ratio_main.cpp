@@ -133,6 +133,27 @@ bool failRuntime(const std::string& message) {
   return false;
 }
 
+// Options whose value is kept as given.
+std::string Arguments::*textOption(const std::string& flag) {
+  static const std::pair<const char*, std::string Arguments::*> kTextOptions[] = {
+      {"--bag", &Arguments::bag},
+      {"--carmen", &Arguments::carmen},
+      {"--csv", &Arguments::csv},
+      {"--plots", &Arguments::plots},
+      {"--algorithms", &Arguments::algorithms},
+      {"--presets", &Arguments::presets},
+      {"--cases", &Arguments::cases},
+      {"--curve-generations", &Arguments::curve_generations},
+      {"--curve-csv", &Arguments::curve_csv},
+      {"--curve-algorithms", &Arguments::curve_algorithms},
+      {"--time-csv", &Arguments::time_csv},
+      {"--title", &Arguments::title}};
+  for (const auto& [name, member] : kTextOptions) {
+    if (flag == name) return member;
+  }
+  return nullptr;
+}
+
 bool parseArguments(int argc, char** argv, Arguments* args) {
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
@@ -154,21 +175,16 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
       args->ceiling = false;
     } else if (!value()) {
       if (flag.rfind("--", 0) != 0) return fail("unexpected argument '" + flag + "'");
-      const bool known = flag == "--bag" || flag == "--topic" || flag == "--carmen" || flag == "--trials" ||
-                         flag == "--seed" || flag == "--csv" || flag == "--plots" || flag == "--algorithms" ||
-                         flag == "--presets" || flag == "--cases" || flag == "--curve-trials" ||
-                         flag == "--curve-generations" || flag == "--curve-csv" || flag == "--max-scans" ||
-                         flag == "--min-points" || flag == "--angle-min" || flag == "--angle-increment" ||
-                         flag == "--title" || flag == "--curve-algorithms" || flag == "--time-csv" ||
+      const bool known = textOption(flag) || flag == "--topic" || flag == "--trials" || flag == "--seed" ||
+                         flag == "--curve-trials" || flag == "--max-scans" || flag == "--min-points" ||
+                         flag == "--angle-min" || flag == "--angle-increment" ||
                          flag == "--interlace-seconds";
       return known ? needs_value() : fail("unknown option '" + flag + "'");
-    } else if (flag == "--bag") {
-      args->bag = text;
+    } else if (std::string Arguments::*member = textOption(flag)) {
+      args->*member = text;
     } else if (flag == "--topic") {
       args->topic = text;
       args->topic_given = true;
-    } else if (flag == "--carmen") {
-      args->carmen = text;
     } else if (flag == "--trials") {
       if (!parseInteger(text, &args->trials) || args->trials < 1) {
         return fail("--trials: expected a positive integer, got '" + text + "'");
@@ -178,24 +194,10 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
       if (!parseInteger(text, &args->seed))
         return fail("--seed: expected an unsigned integer, got '" + text + "'");
       args->seed_given = true;
-    } else if (flag == "--csv") {
-      args->csv = text;
-    } else if (flag == "--plots") {
-      args->plots = text;
-    } else if (flag == "--algorithms") {
-      args->algorithms = text;
-    } else if (flag == "--presets") {
-      args->presets = text;
-    } else if (flag == "--cases") {
-      args->cases = text;
     } else if (flag == "--curve-trials") {
       if (!parseInteger(text, &args->curve_trials) || args->curve_trials < 0) {
         return fail("--curve-trials: expected an integer >= 0, got '" + text + "'");
       }
-    } else if (flag == "--curve-generations") {
-      args->curve_generations = text;
-    } else if (flag == "--curve-csv") {
-      args->curve_csv = text;
     } else if (flag == "--max-scans") {
       if (!parseInteger(text, &args->max_scans))
         return fail("--max-scans: expected an integer, got '" + text + "'");
@@ -211,12 +213,6 @@ bool parseArguments(int argc, char** argv, Arguments* args) {
         return fail("--angle-increment: expected a non-zero number, got '" + text + "'");
       }
       args->override_increment = true;
-    } else if (flag == "--title") {
-      args->title = text;
-    } else if (flag == "--curve-algorithms") {
-      args->curve_algorithms = text;
-    } else if (flag == "--time-csv") {
-      args->time_csv = text;
     } else if (flag == "--interlace-seconds") {
       if (!parseFinite(text, &args->interlace_seconds))
         return fail("--interlace-seconds: not a number: '" + text + "'");

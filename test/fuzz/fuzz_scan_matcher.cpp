@@ -65,7 +65,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint8_t selector = reader.take<std::uint8_t>();
   const hglasm::Preset preset = static_cast<hglasm::Preset>(selector % 3);
   hglasm::MatcherOptions options = hglasm::presetOptions(preset);
-  options.algorithm = static_cast<hglasm::Algorithm>((selector / 3) % 5);
+  options.algorithm = static_cast<hglasm::Algorithm>((selector / 3) % 7);  // PGA and HPGA included
   // Keep each run short: the fuzzer explores inputs, not GA sizes.
   options.genetic.population = 10;
   options.genetic.generations = 3;
