@@ -4,7 +4,6 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
