@@ -103,6 +103,122 @@ SearchEffort sanitised(SearchEffort effort) {
   return effort;
 }
 
+/// The runs of one alignment: a Latin-hypercube population evolved by tournament selection, one-point
+/// crossover, bit mutation and elitism, scored on the coarse fitness for the first coarse_generations
+/// generations and on the fine one after. Counts every evaluation in *evaluations.
+class Evolution {
+ public:
+  Evolution(const GeneticOptions& options, const FitnessStages& stages, const Codec& codec,
+            const SearchEffort& effort, std::mt19937_64& rng, int* evaluations)
+      : options_(options),
+        stages_(stages),
+        codec_(codec),
+        generations_(effort.generations),
+        coarse_generations_(stages.coarse ? effort.coarse_generations : 0),
+        total_bits_(codec.totalBits()),
+        population_size_(effort.population),
+        elite_count_(std::clamp(options.elite_count, 1, effort.population - 1)),
+        // Each bit flips with probability mutation_rate: one random byte per bit, compared with a
+        // threshold (resolution 1/256).
+        mutation_threshold_(
+            static_cast<unsigned>(std::clamp(std::lround(options.mutation_rate * 256.0), 0L, 256L))),
+        rng_(rng),
+        evaluations_(evaluations),
+        random_member_(0, effort.population - 1),
+        random_cut_(1, codec.totalBits() - 1),
+        population_(effort.population),
+        offspring_(effort.population) {}
+
+  /// One run; its final population, scored on the fine fitness.
+  const std::vector<Individual>& run() {
+    scoring_ = coarse_generations_ > 0 ? &stages_.coarse : &stages_.fine;
+    seedLatinHypercube(options_.bits_per_gene, rng_, &slices_, &population_);
+    for (auto& individual : population_) evaluate(individual);
+    for (int generation = 1; generation < generations_; ++generation) {
+      if (generation == coarse_generations_) rescoreOnFine();
+      breed();
+    }
+    // Every generation was coarse: rescore on the fine fitness, the one the guess and the polish use.
+    if (scoring_ != &stages_.fine) rescoreOnFine();
+    return population_;
+  }
+
+ private:
+  void evaluate(Individual& individual) {
+    individual.fitness = (*scoring_)(codec_.decode(individual.chromosome));
+    ++*evaluations_;
+  }
+
+  void rescoreOnFine() {
+    scoring_ = &stages_.fine;
+    for (auto& individual : population_) evaluate(individual);
+  }
+
+  const Individual& tournament() {
+    const Individual* winner = &population_[random_member_(rng_)];
+    for (int k = 1; k < std::min(options_.tournament_size, population_size_); ++k) {
+      const Individual& challenger = population_[random_member_(rng_)];
+      if (challenger.fitness > winner->fitness) winner = &challenger;
+    }
+    return *winner;
+  }
+
+  /// Eight bits per 64-bit draw.
+  std::uint64_t mutate(std::uint64_t chromosome) {
+    std::uint64_t random_bytes = 0;
+    for (int bit = 0; bit < total_bits_; ++bit) {
+      if (bit % 8 == 0) random_bytes = rng_();
+      if ((random_bytes & 0xFF) < mutation_threshold_) chromosome ^= std::uint64_t{1} << bit;
+      random_bytes >>= 8;
+    }
+    return chromosome;
+  }
+
+  /// The next generation replaces the population.
+  void breed() {
+    // Elitism: the best individuals survive unchanged (no re-evaluation needed).
+    std::partial_sort(population_.begin(), population_.begin() + elite_count_, population_.end(),
+                      [](const Individual& a, const Individual& b) { return a.fitness > b.fitness; });
+    std::copy(population_.begin(), population_.begin() + elite_count_, offspring_.begin());
+    for (int i = elite_count_; i < population_size_; i += 2) {
+      std::uint64_t child_a = tournament().chromosome;
+      std::uint64_t child_b = tournament().chromosome;
+      if (unit_(rng_) < options_.crossover_rate) {
+        // One-point crossover on the bit string: exchange the tails below a random cut.
+        const std::uint64_t tail = (std::uint64_t{1} << random_cut_(rng_)) - 1;
+        const std::uint64_t swap = (child_a ^ child_b) & tail;
+        child_a ^= swap;
+        child_b ^= swap;
+      }
+      offspring_[i].chromosome = mutate(child_a);
+      evaluate(offspring_[i]);
+      if (i + 1 < population_size_) {
+        offspring_[i + 1].chromosome = mutate(child_b);
+        evaluate(offspring_[i + 1]);
+      }
+    }
+    population_.swap(offspring_);
+  }
+
+  const GeneticOptions& options_;
+  const FitnessStages& stages_;
+  const Codec& codec_;
+  const int generations_;
+  const int coarse_generations_;
+  const int total_bits_;
+  const int population_size_;
+  const int elite_count_;
+  const unsigned mutation_threshold_;
+  std::mt19937_64& rng_;
+  int* evaluations_;
+  std::uniform_real_distribution<double> unit_{0.0, 1.0};
+  std::uniform_int_distribution<int> random_member_;
+  std::uniform_int_distribution<int> random_cut_;
+  std::vector<Individual> population_, offspring_;
+  std::vector<int> slices_;
+  const PoseFitness* scoring_ = nullptr;
+};
+
 }  // namespace
 
 GeneticAligner::GeneticAligner(const GeneticOptions& options) : options_(options), rng_(options.seed) {
@@ -153,77 +269,11 @@ PreAlignResult GeneticAligner::align(const FitnessStages& stages, const Pose2D& 
   result.evaluations = 1;
 
   const Codec codec(effort.box, guess, options_.bits_per_gene);
-  const int total_bits = codec.totalBits();
-  const int population_size = effort.population;
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::uniform_int_distribution<int> random_member(0, population_size - 1);
-  std::uniform_int_distribution<int> random_cut(1, total_bits - 1);
-
-  std::vector<Individual> population(population_size), offspring(population_size);
-  std::vector<int> slices;
-  const int elite_count = std::clamp(options_.elite_count, 1, population_size - 1);
-  const int coarse_generations = stages.coarse ? effort.coarse_generations : 0;
-  const PoseFitness* scoring = &stages.fine;
-  auto evaluate = [&](Individual& individual) {
-    individual.fitness = (*scoring)(codec.decode(individual.chromosome));
-    ++result.evaluations;
-  };
-  auto tournament = [&]() -> const Individual& {
-    const Individual* winner = &population[random_member(rng_)];
-    for (int k = 1; k < std::min(options_.tournament_size, population_size); ++k) {
-      const Individual& challenger = population[random_member(rng_)];
-      if (challenger.fitness > winner->fitness) winner = &challenger;
-    }
-    return *winner;
-  };
-  // Each bit flips with probability mutation_rate: one random byte per bit, compared with a threshold
-  // (resolution 1/256), eight bits per 64-bit draw.
-  const unsigned mutation_threshold =
-      static_cast<unsigned>(std::clamp(std::lround(options_.mutation_rate * 256.0), 0L, 256L));
-  auto mutate = [&](std::uint64_t chromosome) {
-    std::uint64_t random_bytes = 0;
-    for (int bit = 0; bit < total_bits; ++bit) {
-      if (bit % 8 == 0) random_bytes = rng_();
-      if ((random_bytes & 0xFF) < mutation_threshold) chromosome ^= std::uint64_t{1} << bit;
-      random_bytes >>= 8;
-    }
-    return chromosome;
-  };
-
+  Evolution evolution(options_, stages, codec, effort, rng_, &result.evaluations);
   std::vector<Individual> best_run_population;
   std::uint32_t best_run_fitness = 0;
   for (int run = 0; run < effort.runs; ++run) {
-    scoring = coarse_generations > 0 ? &stages.coarse : &stages.fine;
-    seedLatinHypercube(options_.bits_per_gene, rng_, &slices, &population);
-    for (auto& individual : population) evaluate(individual);
-    for (int generation = 1; generation < effort.generations; ++generation) {
-      if (generation == coarse_generations) {
-        scoring = &stages.fine;  // switch to the fine fitness: rescore the survivors on it
-        for (auto& individual : population) evaluate(individual);
-      }
-      // Elitism: the best individuals survive unchanged (no re-evaluation needed).
-      std::partial_sort(population.begin(), population.begin() + elite_count, population.end(),
-                        [](const Individual& a, const Individual& b) { return a.fitness > b.fitness; });
-      std::copy(population.begin(), population.begin() + elite_count, offspring.begin());
-      for (int i = elite_count; i < population_size; i += 2) {
-        std::uint64_t child_a = tournament().chromosome;
-        std::uint64_t child_b = tournament().chromosome;
-        if (unit(rng_) < options_.crossover_rate) {
-          // One-point crossover on the bit string: exchange the tails below a random cut.
-          const std::uint64_t tail = (std::uint64_t{1} << random_cut(rng_)) - 1;
-          const std::uint64_t swap = (child_a ^ child_b) & tail;
-          child_a ^= swap;
-          child_b ^= swap;
-        }
-        offspring[i].chromosome = mutate(child_a);
-        evaluate(offspring[i]);
-        if (i + 1 < population_size) {
-          offspring[i + 1].chromosome = mutate(child_b);
-          evaluate(offspring[i + 1]);
-        }
-      }
-      population.swap(offspring);
-    }
+    const std::vector<Individual>& population = evolution.run();
     const auto best =
         std::max_element(population.begin(), population.end(),
                          [](const Individual& a, const Individual& b) { return a.fitness < b.fitness; });

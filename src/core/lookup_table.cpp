@@ -7,8 +7,8 @@ namespace hglasm {
 
 LookupTable::LookupTable(const LookupTableOptions& options) : options_(options) {
   // Guard against nonsense sizes here too; the ROS layer validates and names the parameter.
-  if (!(options_.cell_size > 1e-4)) options_.cell_size = 0.02;
-  if (!(options_.sigma > 0.0)) options_.sigma = 0.1;
+  if (!(options_.cell_size > 1e-4)) options_.cell_size = LookupTableOptions().cell_size;
+  if (!(options_.sigma > 0.0)) options_.sigma = LookupTableOptions().sigma;
   if (!(options_.cutoff >= options_.cell_size))
     options_.cutoff = std::max(options_.cell_size, 3 * options_.sigma);
   inv_cell_size_ = 1.0 / options_.cell_size;

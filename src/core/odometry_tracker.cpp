@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -11,10 +12,6 @@ namespace hglasm {
 namespace {
 
 constexpr double kMaxVariance = kUnknownVariance;
-// The velocity is the motion over the last kVelocityBaseline seconds or more: some logs hold bursts of
-// scans ~1 ms apart whose stamps do not match their motion, and a per-step velocity would explode.
-constexpr double kVelocityBaseline = 0.1;  // seconds
-constexpr double kMaxVelocityAge = 2.0;    // seconds: older motion says nothing about the current speed
 constexpr int kMinFitnessHistory = 20;     // matches before the usual fit is known
 constexpr double kFitnessHalfLife = 50.0;  // matches
 
@@ -89,40 +86,53 @@ void OdometryTracker::RunningStats::add(double value) {
   ++count;
 }
 
-const char* toString(PredictionSource source) {
-  switch (source) {
-    case PredictionSource::kOdometry:
-      return "odometry";
-    case PredictionSource::kConstantVelocity:
-      return "constant_velocity";
-    case PredictionSource::kNone:
-      return "none";
-  }
-  return "unknown";
+namespace {
+
+/// Whether the matcher's fine table is the graded one that scans are judged on.
+bool matcherHasGradedTable(Algorithm algorithm) {
+  return algorithm == Algorithm::kHglasmG || algorithm == Algorithm::kGlasmG;
 }
 
+double millisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
 OdometryTracker::OdometryTracker(const TrackerOptions& options)
-    : options_(options), matcher_(options.matcher), noise_(options.motion), local_map_(options.local_map) {}
+    : options_(options),
+      matcher_(options.matcher),
+      extrapolator_(options.use_odometry, options.odometry_max_extrapolation, options.max_odometry_speed,
+                    options.max_odometry_turn_rate),
+      keyframes_(options.keyframe_distance, options.keyframe_angle, options.keyframe_min_fitness),
+      noise_(options.motion),
+      local_map_(options.local_map) {
+  if (!matcherHasGradedTable(options_.matcher.algorithm)) {
+    LookupTableOptions graded = options_.matcher.table;
+    graded.kind = TableKind::kGraded;
+    own_table_.emplace(graded);
+  }
+}
 
 void OdometryTracker::setLaserMount(const Pose2D& base_to_laser) {
   if (base_to_laser.isFinite()) laser_mount_ = base_to_laser;
 }
 
-void OdometryTracker::addOdometry(double stamp, const Pose2D& odom_pose) { odometry_.add(stamp, odom_pose); }
+void OdometryTracker::addOdometry(double stamp, const Pose2D& odom_pose) {
+  extrapolator_.addOdometry(stamp, odom_pose);
+}
 
 void OdometryTracker::reset() {
   initialised_ = false;
   local_map_.clear();
-  keyframe_requested_ = false;
+  keyframes_.cancelRequest();
   pose_ = Pose2D();
   pose_covariance_.setZero();
   map_covariance_.setZero();
-  velocity_.setZero();
-  velocity_valid_ = false;
+  extrapolator_.reset();
   prediction_wrong_ = 0.0;
   fitness_ = RunningStats();
   have_scan_only_pose_ = false;
-  history_.clear();
 }
 
 Pose2D OdometryTracker::toMap(const Pose2D& base_pose) const {
@@ -131,37 +141,6 @@ Pose2D OdometryTracker::toMap(const Pose2D& base_pose) const {
 
 Pose2D OdometryTracker::fromMap(const Pose2D& laser_in_map) const {
   return local_map_.frame() * laser_in_map * laser_mount_.inverse();
-}
-
-OdometryTracker::Prediction OdometryTracker::predict(double stamp, std::string* warning) const {
-  Prediction prediction;
-  const double dt = stamp - last_stamp_;
-  if (options_.use_odometry) {
-    Pose2D odom_last, odom_now;
-    const double reach = options_.odometry_max_extrapolation;
-    if (odometry_.poseAt(last_stamp_, reach, &odom_last) && odometry_.poseAt(stamp, reach, &odom_now)) {
-      const Pose2D motion = relativePose(odom_last, odom_now);
-      const bool plausible = motion.translationNorm() <= options_.max_odometry_speed * dt + 0.2 &&
-                             std::abs(motion.theta) <= options_.max_odometry_turn_rate * dt + 0.2;
-      if (plausible) {
-        prediction.source = PredictionSource::kOdometry;
-        prediction.motion = motion;
-        prediction.covariance = noise_.odometryCovariance(motion, dt);
-        prediction.nominal_covariance = noise_.nominalOdometryCovariance(motion, dt);
-        return prediction;
-      }
-      std::ostringstream text;
-      text << "wheel odometry jumped " << motion.translationNorm() << " m / " << motion.theta << " rad in "
-           << dt << " s; using the constant-velocity prediction";
-      *warning = text.str();
-    }
-  }
-  prediction.covariance = noise_.constantVelocityCovariance(dt);
-  if (velocity_valid_) {
-    prediction.source = PredictionSource::kConstantVelocity;
-    prediction.motion = Pose2D(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
-  }
-  return prediction;
 }
 
 SearchEffort OdometryTracker::searchEffort(const Eigen::Matrix3d& prior_covariance, bool have_prior) const {
@@ -197,7 +176,7 @@ OdometryTracker::Candidate OdometryTracker::evaluate(const Scan& scan, const Mat
   candidate.match = match;
   const Eigen::Vector3d offset = poseDifference(match.pose, prior.mean);
   candidate.mahalanobis_sq = match.pose.isFinite() ? offset.dot(prior.information * offset) : 0.0;
-  candidate.fitness_ratio = match.pose.isFinite() ? matcher_.fitnessRatioAt(scan, match.pose) : 0.0;
+  candidate.fitness_ratio = match.pose.isFinite() ? fitnessRatioAt(scan, match.pose) : 0.0;
   candidate.acceptable = matchUsable(match) && candidate.fitness_ratio >= options_.min_fitness;
   return candidate;
 }
@@ -233,7 +212,18 @@ double OdometryTracker::scanLogLikelihood(const Scan& scan, const Pose2D& pose) 
   const double independent = options_.matcher.mbicp.independent_points;
   const double weight =
       independent > 0.0 ? std::min(1.0, independent / std::max<double>(1.0, scan.size())) : 1.0;
-  return weight * matcher_.logLikelihoodAt(scan, pose, options_.likelihood_outlier);
+  const LookupTable& table = judgingTable();
+  if (table.empty() || scan.empty()) return 0.0;
+  FitnessPoints points;
+  points.assign(scan.points);
+  return weight * table.logLikelihood(points, pose, options_.likelihood_outlier);
+}
+
+double OdometryTracker::fitnessRatioAt(const Scan& scan, const Pose2D& pose) const {
+  const LookupTable& table = judgingTable();
+  if (table.empty() || scan.empty()) return 0.0;
+  const double best = static_cast<double>(table.maxCellValue()) * static_cast<double>(scan.size());
+  return table.fitness(scan.points, pose) / best;
 }
 
 double OdometryTracker::logPrior(const Pose2D& pose, const PosePrior& prior,
@@ -243,7 +233,7 @@ double OdometryTracker::logPrior(const Pose2D& pose, const PosePrior& prior,
   return -0.5 * offset.dot(prior.information * offset) - 0.5 * log_det;
 }
 
-OdometryTracker::Hypotheses OdometryTracker::hypothesesFor(const Prediction& prediction) const {
+OdometryTracker::Hypotheses OdometryTracker::hypothesesFor(const MotionPrediction& prediction) const {
   // The prediction holds: the laser's predicted pose in the local map's frame, uncertain by the previous
   // estimate's uncertainty there plus the motion's noise.
   Hypotheses h;
@@ -354,7 +344,7 @@ void OdometryTracker::estimateFrom(const Candidate& chosen, const Hypotheses& h,
       symmetricClamped(to_increment * increment_in_map * to_increment.transpose());
 }
 
-bool OdometryTracker::matchScan(const Scan& scan, const Prediction& prediction,
+bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& prediction,
                                 std::vector<Pose2D>* population_out, TrackerUpdate* update,
                                 Estimate* estimate) {
   const Hypotheses h = hypothesesFor(prediction);
@@ -383,7 +373,7 @@ bool OdometryTracker::matchScan(const Scan& scan, const Prediction& prediction,
   return true;
 }
 
-void OdometryTracker::learnNoise(const Prediction& prediction, const MatchResult& match) {
+void OdometryTracker::learnNoise(const MotionPrediction& prediction, const MatchResult& match) {
   // Two consecutive scans matched against the same map share most of their error, so the motion between
   // where the scans alone put them is a far better measurement of the increment than any wheels': what
   // the wheels' increment differs from it by is (almost all) their noise.
@@ -399,7 +389,7 @@ void OdometryTracker::learnNoise(const Prediction& prediction, const MatchResult
   scan_only_pose_ = scan_only;
 }
 
-OdometryTracker::Estimate OdometryTracker::integratePrediction(const Prediction& prediction) const {
+OdometryTracker::Estimate OdometryTracker::integratePrediction(const MotionPrediction& prediction) const {
   Estimate estimate;
   const Pose2D laser_previous = toMap(pose_);
   const Pose2D laser_motion = laser_mount_.inverse() * prediction.motion * laser_mount_;
@@ -425,14 +415,14 @@ bool OdometryTracker::handleTime(double stamp, TrackerUpdate* update) {
   reset();
   // Back in time, the odometry history is of another timeline (a looped bag, a clock reset): mixed with
   // the new samples at the same stamps it would turn every prediction into a jump.
-  if (dt < 0.0) odometry_.clear();
+  if (dt < 0.0) extrapolator_.clearOdometry();
   return false;
 }
 
 void OdometryTracker::initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update) {
   initialised_ = true;
   last_stamp_ = stamp;
-  history_.push_back(StampedPose{stamp, pose_});
+  extrapolator_.addPose(stamp, pose_);
   update->reset = true;
   update->published = true;
   update->pose = pose_;
@@ -440,30 +430,17 @@ void OdometryTracker::initialise(double stamp, const Scan& scan, bool usable, Tr
   if (usable) {
     addKeyframe(scan);
     update->new_keyframe = true;
-    update->table_build_ms = matcher_.lastTableBuildMs();
+    update->table_build_ms = table_build_ms_;
   }
   update->keyframe_id = keyframe_id_;
 }
 
 void OdometryTracker::updateVelocity(double stamp, const Pose2D& new_pose, TrackerUpdate* update) {
-  // Velocity over a baseline of at least kVelocityBaseline seconds, capped at the plausible speeds.
-  history_.push_back(StampedPose{stamp, new_pose});
-  while (history_.size() > 2 && stamp - history_[1].stamp >= kVelocityBaseline) history_.pop_front();
-  const double baseline = stamp - history_.front().stamp;
-  if (baseline >= kVelocityBaseline && baseline <= kMaxVelocityAge) {
-    const Pose2D motion = relativePose(history_.front().pose, new_pose);
-    Eigen::Vector3d velocity(motion.x / baseline, motion.y / baseline, motion.theta / baseline);
-    const double speed = velocity.head<2>().norm();
-    if (speed > options_.max_odometry_speed) velocity.head<2>() *= options_.max_odometry_speed / speed;
-    velocity.z() =
-        std::clamp(velocity.z(), -options_.max_odometry_turn_rate, options_.max_odometry_turn_rate);
-    velocity_ = velocity;
-    velocity_valid_ = true;
-    update->velocity_covariance = symmetricClamped(update->increment_covariance / (baseline * baseline));
-  } else {
-    if (baseline > kMaxVelocityAge) velocity_valid_ = false;
-    update->velocity_covariance = Eigen::Matrix3d::Identity() * kMaxVariance;
-  }
+  // The velocity over the baseline's increments is uncertain by their uncertainty over its length.
+  const double baseline = extrapolator_.addPose(stamp, new_pose);
+  update->velocity_covariance = baseline > 0.0
+                                    ? symmetricClamped(update->increment_covariance / (baseline * baseline))
+                                    : Eigen::Matrix3d::Identity() * kMaxVariance;
 }
 
 void OdometryTracker::addKeyframe(const Scan& scan) {
@@ -471,34 +448,31 @@ void OdometryTracker::addKeyframe(const Scan& scan) {
   const Pose2D old_frame = local_map_.frame();
   local_map_.add(pose_ * laser_mount_, scan.points);
   matcher_.setReference(local_map_.reference());
+  table_build_ms_ = matcher_.lastTableBuildMs();
+  if (own_table_) {
+    const auto start = std::chrono::steady_clock::now();
+    own_table_->build(local_map_.reference());
+    table_build_ms_ += millisecondsSince(start);
+  }
   // The pose's uncertainty relative to the map stays; only the frame it is expressed in turns.
   map_covariance_ = had_map ? rotateCovariance(relativePose(local_map_.frame(), old_frame), map_covariance_)
                             : Eigen::Matrix3d::Zero();
-  keyframe_requested_ = false;
-  keyframe_pose_ = pose_;
-  keyframe_beam_count_ = scan.beam_count;
+  keyframes_.keyframeAdded(pose_, scan.beam_count);
   ++keyframe_id_;
 }
 
 void OdometryTracker::updateKeyframe(const Scan& scan, bool usable, TrackerUpdate* update) {
-  // A new keyframe when the robot has moved away from the last one, when the match was poor or failed (the
-  // map no longer explains the scene), or when the scanner changed.
-  const Pose2D since_keyframe = relativePose(keyframe_pose_, pose_);
-  // Only a usable scan can become a keyframe (an empty scan has no geometry): warn when it does.
-  const bool geometry_changed = !local_map_.empty() && usable && scan.beam_count != keyframe_beam_count_;
-  if (geometry_changed && update->warning.empty()) {
-    update->warning = "scan beam count changed from " + std::to_string(keyframe_beam_count_) + " to " +
-                      std::to_string(scan.beam_count) + "; new keyframe";
+  if (!usable) return;  // a scan without geometry cannot become a keyframe
+  const bool scanner_changed = !local_map_.empty() && keyframes_.scannerChanged(scan.beam_count);
+  if (scanner_changed && update->warning.empty()) {
+    update->warning = "scan beam count changed from " + std::to_string(keyframes_.keyframeBeamCount()) +
+                      " to " + std::to_string(scan.beam_count) + "; new keyframe";
   }
-  const bool wants_keyframe = local_map_.empty() || keyframe_requested_ || geometry_changed ||
-                              update->fallback ||
-                              since_keyframe.translationNorm() > options_.keyframe_distance ||
-                              std::abs(since_keyframe.theta) > options_.keyframe_angle ||
-                              (update->matched && update->fitness_ratio < options_.keyframe_min_fitness);
-  if (wants_keyframe && usable) {
+  if (local_map_.empty() || scanner_changed ||
+      keyframes_.wantsKeyframe(pose_, update->matched, update->fallback, update->fitness_ratio)) {
     addKeyframe(scan);
     update->new_keyframe = true;
-    update->table_build_ms = matcher_.lastTableBuildMs();
+    update->table_build_ms = table_build_ms_;
   }
 }
 
@@ -518,8 +492,9 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   // A sweep taken while moving is sheared (the last beam is milliseconds younger than the first), and a
   // match reads the shear as a small turn of one sign per metre: on fr079 it added up to ~25 degrees.
   Scan compensated;
-  const bool deskew = options_.deskew && initialised_ && velocity_valid_ && sensor_scan.hasBeamTimes();
-  if (deskew) compensated = deskewScan(sensor_scan, laserVelocity(laser_mount_, velocity_));
+  const bool deskew =
+      options_.deskew && initialised_ && extrapolator_.velocityKnown() && sensor_scan.hasBeamTimes();
+  if (deskew) compensated = deskewScan(sensor_scan, laserVelocity(laser_mount_, extrapolator_.velocity()));
   const Scan& scan = deskew ? compensated : sensor_scan;
   update.deskewed = deskew;
   const bool usable = static_cast<int>(scan.size()) >= options_.min_points;
@@ -530,7 +505,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   }
 
   std::string prediction_warning;
-  const Prediction prediction = predict(stamp, &prediction_warning);
+  const MotionPrediction prediction = extrapolator_.predict(last_stamp_, stamp, noise_, &prediction_warning);
   if (update.warning.empty()) update.warning = prediction_warning;
   update.prediction = prediction.source;
   update.guess = pose_ * prediction.motion;
@@ -548,6 +523,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
     have_scan_only_pose_ = false;
     update.fallback = true;  // nothing (convincing) to match: keep the motion predicted
     estimate = integratePrediction(prediction);
+    if (usable) update.fitness_ratio = fitnessRatioAt(scan, estimate.laser_in_map);
   }
   const Pose2D new_pose = fromMap(estimate.laser_in_map);
   // What the models leave out (timing, the scans' distortion, the surfaces' own errors) grows with time:
@@ -569,7 +545,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   update.published = true;
   update.pose = pose_;
   update.pose_covariance = pose_covariance_;
-  update.velocity = velocity_;
+  update.velocity = extrapolator_.velocity();
   update.keyframe_id = keyframe_id_;
   update.noise_scale = noise_.scale();
   return update;

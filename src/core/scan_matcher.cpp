@@ -87,40 +87,16 @@ bool parsePreset(const std::string& name, Preset* preset) {
 }
 
 MatcherOptions presetOptions(Preset preset) {
-  // Box and GA size exactly as the papers' Table 1; the rest measured with the success_ratio tool on
-  // intel and fr079 (see README): 4 cm cells cost no success and halve the table build; strong selection
-  // (tournament of 6, 4 elites) with 10 % bit mutation and a coarse first stage find the true pose more
-  // often than the textbook 2-tournament / 3 %.
+  // The defaults of MatcherOptions are the medium preset; the papers' Table 1 grows box and GA together.
   MatcherOptions options;
-  options.table.cell_size = 0.04;
-  options.coarse_table.cell_size = 0.08;
-  options.coarse_table.sigma = 0.30;
-  options.coarse_table.cutoff = 0.60;
-  options.genetic.tournament_size = 6;
-  options.genetic.elite_count = 4;
-  options.genetic.mutation_rate = 0.10;
-  options.genetic.crossover_rate = 0.8;
-  options.genetic.polish_evaluations = 60;
-  // Measured with the evaluate tool on fr079 (all relations: rotation drift 4.3 -> 2.9 deg): once the
-  // estimate settles, a 15 cm gate keeps moved objects and unmatched structure out.
-  options.mbicp.max_distance = 0.30;
-  options.mbicp.fine_max_distance = 0.15;
-  // Measured against the relations of intel, fr079 and aces (README): with 50 the fused odometry leans on
-  // the wheels where the scans know better, with 200 it takes the scans' look-alike leaps.
-  options.mbicp.independent_points = 100.0;
   switch (preset) {
     case Preset::kSmall:
       options.genetic.box = {0.3, 0.3, 0.3};
       options.genetic.population = 20;
       options.genetic.generations = 6;
-      options.genetic.runs = 1;
+      options.genetic.coarse_generations = 0;
       break;
     case Preset::kMedium:
-      options.genetic.box = {1.0, 1.0, 1.0};
-      options.genetic.population = 100;
-      options.genetic.generations = 10;
-      options.genetic.runs = 1;
-      options.genetic.coarse_generations = 3;
       break;
     case Preset::kLarge:
       options.genetic.box = {2.0, 2.0, M_PI};
@@ -131,9 +107,7 @@ MatcherOptions presetOptions(Preset preset) {
       // finds the true basin instead of a 180-degree look-alike more often (intel, whole box, 5 seeds of
       // 500 trials: 97.1 -> 98.6 %).
       options.genetic.coarse_generations = 6;
-      options.coarse_table.cell_size = 0.12;
-      options.coarse_table.sigma = 0.60;
-      options.coarse_table.cutoff = 1.20;
+      options.coarse_table = LookupTableOptions{TableKind::kGraded, 0.12, 0.60, 1.20, 0.30, 0.10};
       break;
   }
   // PGA pairs within the reach of GLASM's tables: the fine table's cut-off, then the coarse one's.
@@ -229,8 +203,8 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
     }
     result.prealign_ms = millisecondsSince(start);
     result.prealigned_pose = result.pose = prealigned.pose;
-    result.fitness = prealigned.fitness;
-    result.fitness_ratio = prealigned.fitness_ratio;
+    result.prealigned_fitness = prealigned.fitness;
+    result.prealigned_fitness_ratio = prealigned.fitness_ratio;
     result.evaluations = prealigned.evaluations;
     if (!usesMbicpStage(options_.algorithm)) {
       result.status = prealigned.fitness > 0 ? MatchStatus::kOk : MatchStatus::kLowFitness;
@@ -242,10 +216,6 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
   }
 
   refineInto(scan, prior, &result);
-  if (!usesGeneticStage(options_.algorithm) && table_.empty()) {
-    // MbICP alone: report the fraction of points associated as the quality ratio.
-    result.fitness_ratio = static_cast<double>(result.associations) / static_cast<double>(scan.size());
-  }
   return result;
 }
 
@@ -280,7 +250,6 @@ MatchResult ScanMatcher::refine(const Scan& scan, const Pose2D& guess, const Pos
   MatchResult result;
   if (!startResult(scan, guess, &result)) return result;
   refineInto(scan, prior, &result);
-  result.fitness_ratio = fitnessRatioAt(scan, result.pose);
   return result;
 }
 

@@ -3,11 +3,60 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace hglasm_odometry {
 namespace {
 
 double finiteOr(double value, double fallback) { return std::isfinite(value) ? value : fallback; }
+
+std::uint32_t nonNegative(int count) { return static_cast<std::uint32_t>(std::max(0, count)); }
+
+/// An arrow marker at `pose`, 0.3 m long, of colour (r, g, b).
+visualization_msgs::Marker arrowMarker(const std_msgs::Header& header, int id, const hglasm::Pose2D& pose,
+                                       float r, float g, float b) {
+  visualization_msgs::Marker marker;
+  marker.header = header;
+  marker.ns = "ga_estimate";
+  marker.id = id;
+  marker.type = visualization_msgs::Marker::ARROW;
+  marker.action = visualization_msgs::Marker::ADD;
+  marker.pose = poseMsgFromPose2D(pose);
+  marker.scale.x = 0.3;
+  marker.scale.y = 0.04;
+  marker.scale.z = 0.04;
+  marker.color.r = r;
+  marker.color.g = g;
+  marker.color.b = b;
+  marker.color.a = 1.0f;
+  return marker;
+}
+
+/// Match's fields that say what happened to the scan and how it was searched.
+void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
+  match->prediction_source = toMsg(update.prediction);
+  match->status = toMsg(update.match.status);
+  match->status_text = hglasm::toString(update.match.status);
+  match->jump_rejected = update.jump_rejected;
+  match->prediction_doubted = update.prediction_doubted;
+  match->leap = update.leap;
+  match->leap_probability = finiteFloat(update.leap_probability);
+  match->map_keyframes = nonNegative(update.map_keyframes);
+  match->search_box.x = update.search.box.half_x;
+  match->search_box.y = update.search.box.half_y;
+  match->search_box.theta = update.search.box.half_theta;
+  match->search_population = nonNegative(update.search.population);
+  match->prior_mahalanobis = finiteFloat(update.prior_mahalanobis);
+  match->noise_scale_xy = finiteFloat(update.noise_scale.xy);
+  match->noise_scale_theta = finiteFloat(update.noise_scale.theta);
+  match->deskewed = update.deskewed;
+  match->mbicp_status = toMsg(update.match.mbicp_status);
+  match->matched = update.matched;
+  match->fallback = update.fallback;
+  match->new_keyframe = update.new_keyframe;
+  match->reset = update.reset;
+  match->keyframe_id = nonNegative(update.keyframe_id);
+}
 
 }  // namespace
 
@@ -152,6 +201,130 @@ boost::array<double, 36> covariance6x6FromPlanar(const Eigen::Matrix3d& covarian
 std::string stripLeadingSlash(const std::string& frame_id) {
   const auto first = frame_id.find_first_not_of('/');
   return first == std::string::npos ? std::string() : frame_id.substr(first);
+}
+
+float finiteFloat(double value) { return std::isfinite(value) ? static_cast<float>(value) : 0.0f; }
+
+std::uint8_t toMsg(hglasm::MatchStatus status) {
+  switch (status) {
+    case hglasm::MatchStatus::kOk:
+      return Match::STATUS_OK;
+    case hglasm::MatchStatus::kNoReference:
+      return Match::STATUS_NO_REFERENCE;
+    case hglasm::MatchStatus::kTooFewPoints:
+      return Match::STATUS_TOO_FEW_POINTS;
+    case hglasm::MatchStatus::kLowFitness:
+      return Match::STATUS_LOW_FITNESS;
+    case hglasm::MatchStatus::kMbicpFailed:
+      return Match::STATUS_MBICP_FAILED;
+    case hglasm::MatchStatus::kMbicpNotConverged:
+      return Match::STATUS_MBICP_NOT_CONVERGED;
+  }
+  return Match::STATUS_NO_REFERENCE;
+}
+
+std::uint8_t toMsg(hglasm::MbicpStatus status) {
+  switch (status) {
+    case hglasm::MbicpStatus::kConverged:
+      return Match::MBICP_CONVERGED;
+    case hglasm::MbicpStatus::kMaxIterations:
+      return Match::MBICP_MAX_ITERATIONS;
+    case hglasm::MbicpStatus::kTooFewAssociations:
+      return Match::MBICP_TOO_FEW_ASSOCIATIONS;
+    case hglasm::MbicpStatus::kDegenerate:
+      return Match::MBICP_DEGENERATE;
+  }
+  return Match::MBICP_DEGENERATE;
+}
+
+std::uint8_t toMsg(hglasm::PredictionSource source) {
+  switch (source) {
+    case hglasm::PredictionSource::kOdometry:
+      return Match::PREDICTION_ODOMETRY;
+    case hglasm::PredictionSource::kConstantVelocity:
+      return Match::PREDICTION_CONSTANT_VELOCITY;
+    case hglasm::PredictionSource::kNone:
+      return Match::PREDICTION_NONE;
+  }
+  return Match::PREDICTION_NONE;
+}
+
+nav_msgs::Odometry odometryMsgFromUpdate(const hglasm::TrackerUpdate& update, const std_msgs::Header& header,
+                                         const std::string& base_frame) {
+  nav_msgs::Odometry odom;
+  odom.header = header;
+  odom.child_frame_id = base_frame;
+  odom.pose.pose = poseMsgFromPose2D(update.pose);
+  odom.pose.covariance = covariance6x6FromPlanar(update.pose_covariance);
+  const bool velocity_finite = update.velocity.allFinite();
+  odom.twist.twist.linear.x = velocity_finite ? update.velocity.x() : 0.0;
+  odom.twist.twist.linear.y = velocity_finite ? update.velocity.y() : 0.0;
+  odom.twist.twist.angular.z = velocity_finite ? update.velocity.z() : 0.0;
+  odom.twist.covariance = covariance6x6FromPlanar(update.velocity_covariance);
+  return odom;
+}
+
+Match matchMsgFromUpdate(const hglasm::PipelineUpdate& result, const std_msgs::Header& scan_header,
+                         double total_ms, std::uint32_t dropped_scans) {
+  const hglasm::TrackerUpdate& update = result.tracker;
+  Match match;
+  match.header.stamp = scan_header.stamp;
+  match.header.frame_id = stripLeadingSlash(scan_header.frame_id);
+  setMatchState(update, &match);
+  if (update.matched) {
+    if (result.laser_guess) match.guess_pose = pose2DMsgFromPose2D(*result.laser_guess);
+    match.prealigned_pose = pose2DMsgFromPose2D(update.match.prealigned_pose);
+    match.final_pose = pose2DMsgFromPose2D(update.match.pose);
+  }
+  match.fitness_ratio = finiteFloat(update.fitness_ratio);
+  match.prealigned_fitness = update.match.prealigned_fitness;
+  match.prealigned_fitness_ratio = finiteFloat(update.match.prealigned_fitness_ratio);
+  match.evaluations = nonNegative(update.match.evaluations);
+  match.iterations = nonNegative(update.match.iterations);
+  match.associations = nonNegative(update.match.associations);
+  match.rms_error = finiteFloat(update.match.rms_error);
+  match.valid_points = static_cast<std::uint32_t>(result.scan.size());
+  match.invalid_points = nonNegative(result.scan.invalid_count);
+  match.table_build_ms = finiteFloat(update.table_build_ms);
+  match.prealign_ms = finiteFloat(update.match.prealign_ms);
+  match.refine_ms = finiteFloat(update.match.refine_ms);
+  match.total_ms = finiteFloat(total_ms);
+  match.dropped_scans = dropped_scans;
+  return match;
+}
+
+visualization_msgs::MarkerArray populationMarkers(const std_msgs::Header& header,
+                                                  const std::vector<hglasm::Pose2D>& population,
+                                                  const hglasm::Pose2D& estimate,
+                                                  const hglasm::Pose2D& guess) {
+  // Each individual as a short heading segment from its position (one LINE_LIST: cheap to send and draw).
+  visualization_msgs::Marker individuals;
+  individuals.header = header;
+  individuals.ns = "ga_population";
+  individuals.id = 0;
+  individuals.type = visualization_msgs::Marker::LINE_LIST;
+  individuals.action = visualization_msgs::Marker::ADD;
+  individuals.pose.orientation.w = 1.0;
+  individuals.scale.x = 0.01;
+  individuals.color.r = 1.0f;
+  individuals.color.g = 0.6f;
+  individuals.color.a = 0.8f;
+  constexpr double kHeadingLength = 0.08;
+  for (const hglasm::Pose2D& pose : population) {
+    if (!pose.isFinite()) continue;
+    geometry_msgs::Point from, to;
+    from.x = pose.x;
+    from.y = pose.y;
+    to.x = pose.x + kHeadingLength * std::cos(pose.theta);
+    to.y = pose.y + kHeadingLength * std::sin(pose.theta);
+    individuals.points.push_back(from);
+    individuals.points.push_back(to);
+  }
+  visualization_msgs::MarkerArray markers;
+  markers.markers.push_back(std::move(individuals));
+  markers.markers.push_back(arrowMarker(header, 1, estimate, 0.1f, 0.9f, 0.1f));
+  markers.markers.push_back(arrowMarker(header, 2, guess, 0.2f, 0.4f, 1.0f));
+  return markers;
 }
 
 }  // namespace hglasm_odometry

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <sstream>
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -26,53 +25,6 @@ double threadCpuMs() {
 
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-/// Floats for the Match message: never NaN.
-float finiteFloat(double value) { return std::isfinite(value) ? static_cast<float>(value) : 0.0f; }
-
-std::uint8_t toMsg(hglasm::MatchStatus status) {
-  switch (status) {
-    case hglasm::MatchStatus::kOk:
-      return Match::STATUS_OK;
-    case hglasm::MatchStatus::kNoReference:
-      return Match::STATUS_NO_REFERENCE;
-    case hglasm::MatchStatus::kTooFewPoints:
-      return Match::STATUS_TOO_FEW_POINTS;
-    case hglasm::MatchStatus::kLowFitness:
-      return Match::STATUS_LOW_FITNESS;
-    case hglasm::MatchStatus::kMbicpFailed:
-      return Match::STATUS_MBICP_FAILED;
-    case hglasm::MatchStatus::kMbicpNotConverged:
-      return Match::STATUS_MBICP_NOT_CONVERGED;
-  }
-  return Match::STATUS_NO_REFERENCE;
-}
-
-std::uint8_t toMsg(hglasm::MbicpStatus status) {
-  switch (status) {
-    case hglasm::MbicpStatus::kConverged:
-      return Match::MBICP_CONVERGED;
-    case hglasm::MbicpStatus::kMaxIterations:
-      return Match::MBICP_MAX_ITERATIONS;
-    case hglasm::MbicpStatus::kTooFewAssociations:
-      return Match::MBICP_TOO_FEW_ASSOCIATIONS;
-    case hglasm::MbicpStatus::kDegenerate:
-      return Match::MBICP_DEGENERATE;
-  }
-  return Match::MBICP_DEGENERATE;
-}
-
-std::uint8_t toMsg(hglasm::PredictionSource source) {
-  switch (source) {
-    case hglasm::PredictionSource::kOdometry:
-      return Match::PREDICTION_ODOMETRY;
-    case hglasm::PredictionSource::kConstantVelocity:
-      return Match::PREDICTION_CONSTANT_VELOCITY;
-    case hglasm::PredictionSource::kNone:
-      return Match::PREDICTION_NONE;
-  }
-  return Match::PREDICTION_NONE;
 }
 
 /// Subscriber queues only need to absorb bursts until the callback moves the message into the bounded
@@ -113,14 +65,14 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
 
   scan_sub_ = nh_.subscribe("scan", kScanSubscriberQueue, &LaserOdometry::scanCallback, this,
                             ros::TransportHints().tcpNoDelay());
-  if (options_.use_odom) {
+  if (options_.tracker.use_odometry) {
     odom_sub_ = nh_.subscribe("odom", kOdomSubscriberQueue, &LaserOdometry::odomCallback, this,
                               ros::TransportHints().tcpNoDelay());
   }
-  ROS_INFO_STREAM(
-      "[" << name_ << "] laser odometry on " << scan_sub_.getTopic()
-          << (options_.use_odom ? " + " + odom_sub_.getTopic() : std::string(" (no wheel odometry)")) << ": "
-          << summarize(options_));
+  ROS_INFO_STREAM("[" << name_ << "] laser odometry on " << scan_sub_.getTopic()
+                      << (options_.tracker.use_odometry ? " + " + odom_sub_.getTopic()
+                                                        : std::string(" (no wheel odometry)"))
+                      << ": " << summarize(options_));
 }
 
 LaserOdometry::~LaserOdometry() {
@@ -333,7 +285,7 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
   if (update.reset) path_.clear();
 
   publish(msg, result, msSince(start));
-  if (want_population && update.matched) publishPopulation(msg.header, update, population);
+  if (want_population && update.matched) publishPopulation(msg.header.stamp, update, population);
 
   ScanRecord record;
   record.time = ros::WallTime::now();
@@ -352,153 +304,56 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
 
 void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::PipelineUpdate& result,
                             double total_ms) {
-  const hglasm::TrackerUpdate& update = result.tracker;
-  const ros::Time stamp = msg.header.stamp;
-  if (update.published) {
-    const boost::array<double, 36> pose_covariance = covariance6x6FromPlanar(update.pose_covariance);
-    const geometry_msgs::Pose pose = poseMsgFromPose2D(update.pose);
-
-    nav_msgs::Odometry odom;
-    odom.header.stamp = stamp;
-    odom.header.frame_id = options_.odom_frame;
-    odom.child_frame_id = options_.base_frame;
-    odom.pose.pose = pose;
-    odom.pose.covariance = pose_covariance;
-    const bool velocity_finite = update.velocity.allFinite();
-    odom.twist.twist.linear.x = velocity_finite ? update.velocity.x() : 0.0;
-    odom.twist.twist.linear.y = velocity_finite ? update.velocity.y() : 0.0;
-    odom.twist.twist.angular.z = velocity_finite ? update.velocity.z() : 0.0;
-    odom.twist.covariance = covariance6x6FromPlanar(update.velocity_covariance);
-    odom_pub_.publish(odom);
-
-    geometry_msgs::PoseWithCovarianceStamped pose_msg;
-    pose_msg.header = odom.header;
-    pose_msg.pose.pose = pose;
-    pose_msg.pose.covariance = pose_covariance;
-    pose_pub_.publish(pose_msg);
-
-    if (options_.publish_tf) {
-      geometry_msgs::TransformStamped transform;
-      transform.header = odom.header;
-      transform.child_frame_id = options_.base_frame;
-      transform.transform = transformMsgFromPose2D(update.pose);
-      tf_broadcaster_.sendTransform(transform);
-    }
-
-    if (options_.path_length > 0) {
-      geometry_msgs::PoseStamped path_pose;
-      path_pose.header = odom.header;
-      path_pose.pose = pose;
-      path_.push_back(path_pose);
-      while (path_.size() > static_cast<std::size_t>(options_.path_length)) path_.pop_front();
-      if (path_pub_.getNumSubscribers() > 0) {
-        nav_msgs::Path path;
-        path.header = odom.header;
-        path.poses.assign(path_.begin(), path_.end());
-        path_pub_.publish(path);
-      }
-    }
-  }
-
-  Match match;
-  match.header.stamp = stamp;
-  match.header.frame_id = stripLeadingSlash(msg.header.frame_id);
-  match.prediction_source = toMsg(update.prediction);
-  match.status = toMsg(update.match.status);
-  match.status_text = hglasm::toString(update.match.status);
-  match.jump_rejected = update.jump_rejected;
-  match.prediction_doubted = update.prediction_doubted;
-  match.leap = update.leap;
-  match.leap_probability = finiteFloat(update.leap_probability);
-  match.map_keyframes = static_cast<std::uint32_t>(std::max(0, update.map_keyframes));
-  match.search_box.x = update.search.box.half_x;
-  match.search_box.y = update.search.box.half_y;
-  match.search_box.theta = update.search.box.half_theta;
-  match.search_population = static_cast<std::uint32_t>(std::max(0, update.search.population));
-  match.prior_mahalanobis = finiteFloat(update.prior_mahalanobis);
-  match.noise_scale_xy = finiteFloat(update.noise_scale.xy);
-  match.noise_scale_theta = finiteFloat(update.noise_scale.theta);
-  match.deskewed = update.deskewed;
-  match.mbicp_status = toMsg(update.match.mbicp_status);
-  match.matched = update.matched;
-  match.fallback = update.fallback;
-  match.new_keyframe = update.new_keyframe;
-  match.reset = update.reset;
-  match.keyframe_id = static_cast<std::uint32_t>(std::max(0, update.keyframe_id));
-  if (update.matched) {
-    if (result.laser_guess) match.guess_pose = pose2DMsgFromPose2D(*result.laser_guess);
-    match.prealigned_pose = pose2DMsgFromPose2D(update.match.prealigned_pose);
-    match.final_pose = pose2DMsgFromPose2D(update.match.pose);
-  }
-  match.fitness = update.match.fitness;
-  match.fitness_ratio = finiteFloat(update.match.fitness_ratio);
-  match.evaluations = static_cast<std::uint32_t>(std::max(0, update.match.evaluations));
-  match.iterations = static_cast<std::uint32_t>(std::max(0, update.match.iterations));
-  match.associations = static_cast<std::uint32_t>(std::max(0, update.match.associations));
-  match.rms_error = finiteFloat(update.match.rms_error);
-  match.valid_points = static_cast<std::uint32_t>(result.scan.size());
-  match.invalid_points = static_cast<std::uint32_t>(std::max(0, result.scan.invalid_count));
-  match.table_build_ms = finiteFloat(update.table_build_ms);
-  match.prealign_ms = finiteFloat(update.match.prealign_ms);
-  match.refine_ms = finiteFloat(update.match.refine_ms);
-  match.total_ms = finiteFloat(total_ms);
+  if (result.tracker.published) publishPose(msg.header.stamp, result.tracker);
+  std::uint32_t dropped_scans = 0;
   {
     std::lock_guard<std::mutex> lock(input_mutex_);
-    match.dropped_scans = dropped_scans_;
+    dropped_scans = dropped_scans_;
   }
-  match_pub_.publish(match);
+  match_pub_.publish(matchMsgFromUpdate(result, msg.header, total_ms, dropped_scans));
 }
 
-void LaserOdometry::publishPopulation(const std_msgs::Header& header, const hglasm::TrackerUpdate& update,
-                                      const std::vector<hglasm::Pose2D>& population) {
-  visualization_msgs::MarkerArray markers;
-  // Each individual as a short heading segment from its position (one LINE_LIST: cheap to send and draw).
-  visualization_msgs::Marker individuals;
-  individuals.header.stamp = header.stamp;
-  individuals.header.frame_id = options_.odom_frame;
-  individuals.ns = "ga_population";
-  individuals.id = 0;
-  individuals.type = visualization_msgs::Marker::LINE_LIST;
-  individuals.action = visualization_msgs::Marker::ADD;
-  individuals.pose.orientation.w = 1.0;
-  individuals.scale.x = 0.01;
-  individuals.color.r = 1.0f;
-  individuals.color.g = 0.6f;
-  individuals.color.a = 0.8f;
-  constexpr double kHeadingLength = 0.08;
-  for (const hglasm::Pose2D& pose : population) {
-    if (!pose.isFinite()) continue;
-    geometry_msgs::Point from, to;
-    from.x = pose.x;
-    from.y = pose.y;
-    to.x = pose.x + kHeadingLength * std::cos(pose.theta);
-    to.y = pose.y + kHeadingLength * std::sin(pose.theta);
-    individuals.points.push_back(from);
-    individuals.points.push_back(to);
-  }
-  markers.markers.push_back(individuals);
+void LaserOdometry::publishPose(const ros::Time& stamp, const hglasm::TrackerUpdate& update) {
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = options_.odom_frame;
+  const nav_msgs::Odometry odom = odometryMsgFromUpdate(update, header, options_.base_frame);
+  odom_pub_.publish(odom);
 
-  // The final estimate (green) and the prediction the search box was centred on (blue).
-  auto arrow = [&](int id, const hglasm::Pose2D& pose, float r, float g, float b) {
-    visualization_msgs::Marker marker;
-    marker.header = individuals.header;
-    marker.ns = "ga_estimate";
-    marker.id = id;
-    marker.type = visualization_msgs::Marker::ARROW;
-    marker.action = visualization_msgs::Marker::ADD;
-    marker.pose = poseMsgFromPose2D(pose);
-    marker.scale.x = 0.3;
-    marker.scale.y = 0.04;
-    marker.scale.z = 0.04;
-    marker.color.r = r;
-    marker.color.g = g;
-    marker.color.b = b;
-    marker.color.a = 1.0f;
-    return marker;
-  };
-  markers.markers.push_back(arrow(1, update.pose, 0.1f, 0.9f, 0.1f));
-  markers.markers.push_back(arrow(2, update.guess, 0.2f, 0.4f, 1.0f));
-  population_pub_.publish(markers);
+  geometry_msgs::PoseWithCovarianceStamped pose_msg;
+  pose_msg.header = header;
+  pose_msg.pose = odom.pose;
+  pose_pub_.publish(pose_msg);
+
+  if (options_.publish_tf) {
+    geometry_msgs::TransformStamped transform;
+    transform.header = header;
+    transform.child_frame_id = options_.base_frame;
+    transform.transform = transformMsgFromPose2D(update.pose);
+    tf_broadcaster_.sendTransform(transform);
+  }
+
+  if (options_.path_length > 0) {
+    geometry_msgs::PoseStamped path_pose;
+    path_pose.header = header;
+    path_pose.pose = odom.pose.pose;
+    path_.push_back(path_pose);
+    while (path_.size() > static_cast<std::size_t>(options_.path_length)) path_.pop_front();
+    if (path_pub_.getNumSubscribers() > 0) {
+      nav_msgs::Path path;
+      path.header = header;
+      path.poses.assign(path_.begin(), path_.end());
+      path_pub_.publish(path);
+    }
+  }
+}
+
+void LaserOdometry::publishPopulation(const ros::Time& stamp, const hglasm::TrackerUpdate& update,
+                                      const std::vector<hglasm::Pose2D>& population) {
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = options_.odom_frame;
+  population_pub_.publish(populationMarkers(header, population, update.pose, update.guess));
 }
 
 void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {

@@ -51,13 +51,27 @@ std::string formatNumber(double value) {
   return out.str();
 }
 
+/// The ranges every option visitor shares: the reader below validates them, the writer ignores them.
+template <typename Derived>
+class OptionVisitor {
+ public:
+  void positiveNumber(const std::string& path, double* value) { self().number(path, value, 0.0, kInf, true); }
+  void nonNegativeNumber(const std::string& path, double* value) { self().number(path, value, 0.0, kInf); }
+  void fraction(const std::string& path, double* value) { self().number(path, value, 0.0, 1.0); }
+  void positiveInteger(const std::string& path, int* value) {
+    self().integer(path, value, 1, std::numeric_limits<int>::max());
+  }
+
+ private:
+  Derived& self() { return static_cast<Derived&>(*this); }
+};
+
 /// Typed, validating reads from one parameter subtree. The first error wins; later reads are no-ops.
 /// Every path read is remembered, so the keys never read can be reported as unknown.
-class ParamTree {
+class ParamTree : public OptionVisitor<ParamTree> {
  public:
   ParamTree(const XmlRpcValue& root, std::string display_prefix, std::string* error)
       : root_(root), prefix_(std::move(display_prefix)), error_(error) {}
-
   bool failed() const { return failed_; }
 
   /// Finds `path` ("genetic/population"); false if absent. Marks the path as known either way.
@@ -121,10 +135,6 @@ class ParamTree {
     *out = number;
   }
 
-  void positiveNumber(const std::string& path, double* out) { number(path, out, 0.0, kInf, true); }
-  void nonNegativeNumber(const std::string& path, double* out) { number(path, out, 0.0, kInf); }
-  void fraction(const std::string& path, double* out) { number(path, out, 0.0, 1.0); }
-
   /// An integer within [lo, hi].
   void integer(const std::string& path, int* out, int lo, int hi) {
     XmlRpcValue value;
@@ -148,9 +158,6 @@ class ParamTree {
     }
     *out = number;
   }
-  void positiveInteger(const std::string& path, int* out) {
-    integer(path, out, 1, std::numeric_limits<int>::max());
-  }
 
   void boolean(const std::string& path, bool* out) {
     XmlRpcValue value;
@@ -172,6 +179,19 @@ class ParamTree {
     }
     *out = static_cast<std::string>(value);
     return true;
+  }
+
+  /// A frame id (a non-empty string; a leading slash is dropped, tf2 rejects it).
+  void frame(const std::string& path, std::string* out) {
+    std::string frame;
+    if (string(path, &frame)) *out = stripLeadingSlash(frame);
+  }
+
+  void algorithm(const std::string& path, hglasm::Algorithm* out) {
+    std::string name;
+    if (string(path, &name) && !hglasm::parseAlgorithm(name, out)) {
+      fail(path, "one of hglasm_g, hglasm_binary, glasm_g, glasm_binary, mbicp, pga, hpga", describe(name));
+    }
   }
 
   /// Leaf paths present in the tree but never read (typos), skipping the given top-level keys.
@@ -202,25 +222,49 @@ class ParamTree {
   std::set<std::string> known_;
 };
 
-/// Reads every option except ~preset itself (which selects the starting point). Used for the
-/// ~presets/<name> subtree and for the top level alike.
-void readOptions(ParamTree& tree, LaserOdometryOptions* options) {
+/// Writes every option at its parameter path: what loadOptions would read back unchanged.
+class ParamWriter : public OptionVisitor<ParamWriter> {
+ public:
+  explicit ParamWriter(XmlRpcValue* root) : root_(root) {}
+
+  void number(const std::string& path, double* value, double, double, bool = false, bool = false) {
+    set(path, XmlRpcValue(*value));
+  }
+  void integer(const std::string& path, int* value, int, int) { set(path, XmlRpcValue(*value)); }
+  void boolean(const std::string& path, bool* value) { set(path, XmlRpcValue(*value)); }
+  void frame(const std::string& path, std::string* value) { set(path, XmlRpcValue(*value)); }
+  void algorithm(const std::string& path, hglasm::Algorithm* value) {
+    set(path, XmlRpcValue(std::string(hglasm::toString(*value))));
+  }
+
+ private:
+  void set(const std::string& path, const XmlRpcValue& value) {
+    XmlRpcValue* node = root_;
+    std::size_t start = 0;
+    for (std::size_t slash; (slash = path.find('/', start)) != std::string::npos; start = slash + 1) {
+      node = &(*node)[path.substr(start, slash - start)];
+    }
+    (*node)[path.substr(start)] = value;
+  }
+
+  XmlRpcValue* root_;
+};
+
+/// Every option except ~preset itself (which selects the starting point), each at its parameter path with
+/// its valid range: read (ParamTree) from the ~presets/<name> subtree and from the top level alike, or
+/// written (ParamWriter). The one list of the parameters.
+template <typename Params>
+void visitOptions(Params& tree, LaserOdometryOptions* options) {
   hglasm::TrackerOptions& tracker = options->tracker;
   hglasm::MatcherOptions& matcher = tracker.matcher;
 
-  std::string algorithm_name;
-  if (tree.string("algorithm", &algorithm_name) &&
-      !hglasm::parseAlgorithm(algorithm_name, &matcher.algorithm)) {
-    tree.fail("algorithm", "one of hglasm_g, hglasm_binary, glasm_g, glasm_binary, mbicp",
-              "string \"" + algorithm_name + "\"");
-  }
+  tree.algorithm("algorithm", &matcher.algorithm);
 
   // Frames, topics' behaviour, queue.
-  std::string frame;
-  if (tree.string("odom_frame", &frame)) options->odom_frame = stripLeadingSlash(frame);
-  if (tree.string("base_frame", &frame)) options->base_frame = stripLeadingSlash(frame);
+  tree.frame("odom_frame", &options->odom_frame);
+  tree.frame("base_frame", &options->base_frame);
   tree.boolean("publish_tf", &options->publish_tf);
-  tree.boolean("use_odom", &options->use_odom);
+  tree.boolean("use_odom", &tracker.use_odometry);
   tree.integer("path_length", &options->path_length, 0, 1000000);
   tree.integer("queue_size", &options->queue_size, 1, 10000);
   tree.boolean("publish_population", &options->publish_population);
@@ -302,7 +346,7 @@ void readOptions(ParamTree& tree, LaserOdometryOptions* options) {
   tree.fraction("genetic/crossover_rate", &genetic.crossover_rate);
   tree.fraction("genetic/mutation_rate", &genetic.mutation_rate);
   tree.positiveInteger("genetic/tournament_size", &genetic.tournament_size);
-  tree.integer("genetic/elite_count", &genetic.elite_count, 0, 100000);
+  tree.integer("genetic/elite_count", &genetic.elite_count, 1, 100000);
   tree.integer("genetic/max_points", &genetic.max_points, 0, 1000000);
   tree.integer("genetic/polish_evaluations", &genetic.polish_evaluations, 0, 1000000);
   tree.integer("genetic/coarse_generations", &genetic.coarse_generations, 0, 100000);
@@ -383,6 +427,59 @@ bool checkConsistency(const LaserOdometryOptions& options, std::string* error) {
   return true;
 }
 
+/// Layer 1: the built-in values of the preset ~preset names. *in_yaml: ~presets/<name> exists (layer 2),
+/// then copied into *preset_tree.
+bool startFromPreset(ParamTree& top, LaserOdometryOptions* options, bool* in_yaml, XmlRpcValue* preset_tree,
+                     std::string* error) {
+  std::string preset_name = options->preset;
+  if (!top.string("preset", &preset_name) && top.failed()) return false;
+  XmlRpcValue presets;
+  const bool has_presets = top.find("presets", &presets);
+  if (has_presets && presets.getType() != XmlRpcValue::TypeStruct) {
+    if (error) *error = "parameter ~presets must be a dictionary of presets, got " + describe(presets);
+    return false;
+  }
+  const bool preset_in_yaml = has_presets && presets.hasMember(preset_name);
+  hglasm::Preset builtin = hglasm::Preset::kMedium;  // what a preset defined in YAML alone builds on
+  if (!hglasm::parsePreset(preset_name, &builtin) && !preset_in_yaml) {
+    if (error) {
+      *error =
+          "parameter ~preset must be one of small, medium, large (or a preset defined under ~presets), "
+          "got string \"" +
+          preset_name + "\"";
+    }
+    return false;
+  }
+  options->preset = preset_name;
+  options->tracker.matcher = hglasm::presetOptions(builtin);
+  *in_yaml = preset_in_yaml;
+  if (preset_in_yaml) *preset_tree = presets[preset_name];
+  return true;
+}
+
+/// Layer 2: ~presets/<name> (config/presets.yaml).
+bool applyPresetTree(const XmlRpcValue& preset_tree, LaserOdometryOptions* options, std::string* error,
+                     std::vector<std::string>* warnings) {
+  const std::string prefix = "~presets/" + options->preset;
+  if (preset_tree.getType() != XmlRpcValue::TypeStruct) {
+    if (error) *error = "parameter " + prefix + " must be a dictionary, got " + describe(preset_tree);
+    return false;
+  }
+  std::string preset_error;
+  ParamTree preset_params(preset_tree, prefix + "/", &preset_error);
+  visitOptions(preset_params, options);
+  if (preset_params.failed()) {
+    if (error) *error = preset_error;
+    return false;
+  }
+  if (warnings) {
+    for (const std::string& path : preset_params.unknownPaths({})) {
+      warnings->push_back("unknown parameter " + path + " (ignored)");
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool loadOptions(const XmlRpcValue& private_params, LaserOdometryOptions* options, std::string* error,
@@ -395,68 +492,22 @@ bool loadOptions(const XmlRpcValue& private_params, LaserOdometryOptions* option
   }
   std::string top_error;
   ParamTree top(root, "~", &top_error);
-
   *options = LaserOdometryOptions();
+  bool preset_in_yaml = false;
+  XmlRpcValue preset_tree;
+  if (!startFromPreset(top, options, &preset_in_yaml, &preset_tree, error)) {
+    if (error && top.failed()) *error = top_error;
+    return false;
+  }
+  if (preset_in_yaml && !applyPresetTree(preset_tree, options, error, warnings)) return false;
 
-  // 1. The preset's built-in values.
-  std::string preset_name = options->preset;
-  top.string("preset", &preset_name);
+  // Layer 3: the top level (config/laser_odometry.yaml, single overrides).
+  visitOptions(top, options);
   if (top.failed()) {
     if (error) *error = top_error;
     return false;
   }
-  XmlRpcValue presets;
-  const bool has_presets = top.find("presets", &presets);
-  if (has_presets && presets.getType() != XmlRpcValue::TypeStruct) {
-    if (error) *error = "parameter ~presets must be a dictionary of presets, got " + describe(presets);
-    return false;
-  }
-  const bool preset_in_yaml = has_presets && presets.hasMember(preset_name);
-  hglasm::Preset builtin = hglasm::Preset::kMedium;
-  const bool preset_builtin = hglasm::parsePreset(preset_name, &builtin);
-  if (!preset_builtin && !preset_in_yaml) {
-    if (error) {
-      *error =
-          "parameter ~preset must be one of small, medium, large (or a preset defined under ~presets), "
-          "got string \"" +
-          preset_name + "\"";
-    }
-    return false;
-  }
-  options->preset = preset_name;
-  options->tracker.matcher = hglasm::presetOptions(builtin);
-
-  // 2. ~presets/<name> from config/presets.yaml.
-  if (preset_in_yaml) {
-    XmlRpcValue preset_tree = presets[preset_name];
-    if (preset_tree.getType() != XmlRpcValue::TypeStruct) {
-      if (error)
-        *error = "parameter ~presets/" + preset_name + " must be a dictionary, got " + describe(preset_tree);
-      return false;
-    }
-    std::string preset_error;
-    ParamTree preset_params(preset_tree, "~presets/" + preset_name + "/", &preset_error);
-    readOptions(preset_params, options);
-    if (preset_params.failed()) {
-      if (error) *error = preset_error;
-      return false;
-    }
-    if (warnings) {
-      for (const std::string& path : preset_params.unknownPaths({})) {
-        warnings->push_back("unknown parameter " + path + " (ignored)");
-      }
-    }
-  }
-
-  // 3. Top-level overrides.
-  readOptions(top, options);
-  if (top.failed()) {
-    if (error) *error = top_error;
-    return false;
-  }
-  options->tracker.use_odometry = options->use_odom;
   if (!checkConsistency(*options, error)) return false;
-
   if (warnings) {
     // diagnostic_period belongs to diagnostic_updater, which reads it from the same namespace.
     for (const std::string& path : top.unknownPaths({"presets", "diagnostic_period"})) {
@@ -464,6 +515,14 @@ bool loadOptions(const XmlRpcValue& private_params, LaserOdometryOptions* option
     }
   }
   return true;
+}
+
+XmlRpcValue toParams(const LaserOdometryOptions& options) {
+  XmlRpcValue params;
+  ParamWriter writer(&params);
+  LaserOdometryOptions copy = options;  // the visitor reads through non-const pointers
+  visitOptions(writer, &copy);
+  return params;
 }
 
 bool loadOptions(const ros::NodeHandle& private_nh, LaserOdometryOptions* options, std::string* error,
@@ -483,7 +542,7 @@ std::string summarize(const LaserOdometryOptions& options) {
       << matcher.table.cell_size << " m, keyframe " << options.tracker.keyframe_distance << " m / "
       << options.tracker.keyframe_angle << " rad, " << options.odom_frame << " -> " << options.base_frame
       << (options.publish_tf ? " (tf)" : " (no tf)")
-      << (options.use_odom ? ", wheel odometry in" : ", no wheel odometry") << ", queue "
+      << (options.tracker.use_odometry ? ", wheel odometry in" : ", no wheel odometry") << ", queue "
       << options.queue_size;
   return out.str();
 }

@@ -112,6 +112,98 @@ bool matchesStamp(const std::vector<double>& sorted_stamps, double t) {
   return it != sorted_stamps.end() && *it <= t + kTolerance;
 }
 
+/// Pass 1: the stamps of the scans in the slice, sorted (empty, with a message, if there are none).
+std::vector<double> selectScans(rosbag::Bag& input, const Options& options) {
+  std::vector<double> stamps;
+  {
+    rosbag::View scans(input, rosbag::TopicQuery(options.scan_topic));
+    for (const rosbag::MessageInstance& m : scans) stamps.push_back(stampOf(m));
+  }
+  if (stamps.empty()) {
+    std::cerr << "cut_bag: no messages on " << options.scan_topic << " in " << options.input << "\n";
+    return {};
+  }
+  std::sort(stamps.begin(), stamps.end());
+  const double window_start = stamps.front() + options.start;
+  const double window_end = window_start + options.duration;
+  std::vector<double> selected;
+  std::size_t skipped = 0;
+  for (double stamp : stamps) {
+    if (stamp < window_start) continue;
+    if (stamp > window_end || selected.size() >= options.max_scans) break;
+    if (skipped < options.skip_scans) {
+      ++skipped;
+      continue;
+    }
+    selected.push_back(stamp);
+  }
+  if (selected.empty()) std::cerr << "cut_bag: the requested slice holds no scans\n";
+  return selected;
+}
+
+/// Pass 2: copies the scans stamped first..last, odometry and tf within the margin around them, and every
+/// tf_static message (latched, at the slice's start).
+void copySlice(rosbag::Bag& input, const Options& options, double first, double last) {
+  const ros::Time tf_static_time(std::max(0.0, first - options.margin));
+  rosbag::Bag output(options.output, rosbag::bagmode::Write);
+  output.setCompression(options.compression);
+  std::size_t scan_count = 0, odom_count = 0, tf_count = 0, tf_static_count = 0;
+  rosbag::View all(input);
+  for (const rosbag::MessageInstance& m : all) {
+    const std::string& topic = m.getTopic();
+    if (topic == "/tf_static") {
+      auto header = boost::make_shared<ros::M_string>(*m.getConnectionHeader());
+      (*header)["latching"] = "1";
+      output.write(topic, tf_static_time, m, header);
+      ++tf_static_count;
+    } else if (topic == options.scan_topic) {
+      const double stamp = stampOf(m);
+      if (stamp < first || stamp > last) continue;
+      output.write(topic, m.getTime(), m, m.getConnectionHeader());
+      ++scan_count;
+    } else if (topic == options.odom_topic || topic == "/tf") {
+      const double t = m.getTime().toSec();
+      if (t < first - options.margin || t > last + options.margin) continue;
+      output.write(topic, m.getTime(), m, m.getConnectionHeader());
+      ++(topic == "/tf" ? tf_count : odom_count);
+    }
+  }
+  output.close();
+  std::cout << "cut_bag: wrote " << options.output << ": " << scan_count << " scans (" << std::fixed
+            << (last - first) << " s from stamp " << first << "), " << odom_count << " odometry, " << tf_count
+            << " tf, " << tf_static_count << " tf_static messages\n";
+}
+
+/// The relations of options.relations whose both stamps are scans of the slice, next to the output bag.
+bool cutRelations(const Options& options, const std::vector<double>& selected) {
+  std::ifstream in(options.relations);
+  if (!in) {
+    std::cerr << "cut_bag: cannot read " << options.relations << "\n";
+    return false;
+  }
+  const std::string relations_out = relationsPathFor(options.output);
+  std::ofstream out(relations_out);
+  std::size_t kept = 0, total = 0;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    double t1 = 0.0, t2 = 0.0;
+    if (!(fields >> t1 >> t2)) continue;
+    ++total;
+    if (matchesStamp(selected, t1) && matchesStamp(selected, t2)) {
+      out << line << "\n";
+      ++kept;
+    }
+  }
+  if (!out) {
+    std::cerr << "cut_bag: cannot write " << relations_out << "\n";
+    return false;
+  }
+  std::cout << "cut_bag: wrote " << relations_out << ": " << kept << " of " << total
+            << " relations lie inside the slice\n";
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -120,95 +212,10 @@ int main(int argc, char** argv) {
   if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
   try {
     rosbag::Bag input(options.input, rosbag::bagmode::Read);
-
-    // Pass 1: the scan stamps, sorted, and the slice chosen from them.
-    std::vector<double> stamps;
-    {
-      rosbag::View scans(input, rosbag::TopicQuery(options.scan_topic));
-      for (const rosbag::MessageInstance& m : scans) stamps.push_back(stampOf(m));
-    }
-    if (stamps.empty()) {
-      std::cerr << "cut_bag: no messages on " << options.scan_topic << " in " << options.input << "\n";
-      return 1;
-    }
-    std::sort(stamps.begin(), stamps.end());
-    const double window_start = stamps.front() + options.start;
-    const double window_end = window_start + options.duration;
-    std::vector<double> selected;
-    std::size_t skipped = 0;
-    for (double stamp : stamps) {
-      if (stamp < window_start) continue;
-      if (stamp > window_end || selected.size() >= options.max_scans) break;
-      if (skipped < options.skip_scans) {
-        ++skipped;
-        continue;
-      }
-      selected.push_back(stamp);
-    }
-    if (selected.empty()) {
-      std::cerr << "cut_bag: the requested slice holds no scans\n";
-      return 1;
-    }
-    const double first = selected.front();
-    const double last = selected.back();
-    const ros::Time tf_static_time(std::max(0.0, first - options.margin));
-
-    // Pass 2: copy.
-    rosbag::Bag output(options.output, rosbag::bagmode::Write);
-    output.setCompression(options.compression);
-    std::size_t scan_count = 0, odom_count = 0, tf_count = 0, tf_static_count = 0;
-    rosbag::View all(input);
-    for (const rosbag::MessageInstance& m : all) {
-      const std::string& topic = m.getTopic();
-      if (topic == "/tf_static") {
-        auto header = boost::make_shared<ros::M_string>(*m.getConnectionHeader());
-        (*header)["latching"] = "1";
-        output.write(topic, tf_static_time, m, header);
-        ++tf_static_count;
-      } else if (topic == options.scan_topic) {
-        const double stamp = stampOf(m);
-        if (stamp < first || stamp > last) continue;
-        output.write(topic, m.getTime(), m, m.getConnectionHeader());
-        ++scan_count;
-      } else if (topic == options.odom_topic || topic == "/tf") {
-        const double t = m.getTime().toSec();
-        if (t < first - options.margin || t > last + options.margin) continue;
-        output.write(topic, m.getTime(), m, m.getConnectionHeader());
-        ++(topic == "/tf" ? tf_count : odom_count);
-      }
-    }
-    output.close();
-    std::cout << "cut_bag: wrote " << options.output << ": " << scan_count << " scans (" << std::fixed
-              << (last - first) << " s from stamp " << first << "), " << odom_count << " odometry, "
-              << tf_count << " tf, " << tf_static_count << " tf_static messages\n";
-
-    if (!options.relations.empty()) {
-      std::ifstream in(options.relations);
-      if (!in) {
-        std::cerr << "cut_bag: cannot read " << options.relations << "\n";
-        return 1;
-      }
-      const std::string relations_out = relationsPathFor(options.output);
-      std::ofstream out(relations_out);
-      std::size_t kept = 0, total = 0;
-      std::string line;
-      while (std::getline(in, line)) {
-        std::istringstream fields(line);
-        double t1 = 0.0, t2 = 0.0;
-        if (!(fields >> t1 >> t2)) continue;
-        ++total;
-        if (matchesStamp(selected, t1) && matchesStamp(selected, t2)) {
-          out << line << "\n";
-          ++kept;
-        }
-      }
-      if (!out) {
-        std::cerr << "cut_bag: cannot write " << relations_out << "\n";
-        return 1;
-      }
-      std::cout << "cut_bag: wrote " << relations_out << ": " << kept << " of " << total
-                << " relations lie inside the slice\n";
-    }
+    const std::vector<double> selected = selectScans(input, options);
+    if (selected.empty()) return 1;
+    copySlice(input, options, selected.front(), selected.back());
+    if (!options.relations.empty() && !cutRelations(options, selected)) return 1;
   } catch (const rosbag::BagException& ex) {
     std::cerr << "cut_bag: " << ex.what() << "\n";
     return 1;

@@ -86,87 +86,69 @@ void printAccuracyRow(const char* label, const hglasm::RelationStats& laser,
               laser.trans_mean, laser.rot_mean_deg, wheel.trans_mean, wheel.rot_mean_deg);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  ros::init(argc, argv, "demo_report", ros::init_options::AnonymousName);
-  Options options;
-  const auto parsed = parseArguments(argc, argv, &options);
-  if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
-
-  // The bag: its scan stamps (what must come out) and wheel odometry (for comparison).
-  std::vector<double> scan_stamps;
-  hglasm::OdometryBuffer wheel(1e9);
+/// The bag's scan stamps (sorted: what must come out) and its wheel odometry (for comparison).
+bool readBagInputs(const Options& options, std::vector<double>* scan_stamps, hglasm::OdometryBuffer* wheel) {
   try {
     rosbag::Bag bag(options.bag, rosbag::bagmode::Read);
     for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
       if (m.getTopic() == options.scan_topic) {
         if (auto scan = m.instantiate<sensor_msgs::LaserScan>())
-          scan_stamps.push_back(scan->header.stamp.toSec());
+          scan_stamps->push_back(scan->header.stamp.toSec());
       } else if (m.getTopic() == options.wheel_odom_topic) {
         auto odom = m.instantiate<nav_msgs::Odometry>();
         hglasm::Pose2D pose;
         if (odom && hglasm_odometry::pose2DFromOdometryMsg(*odom, &pose))
-          wheel.add(odom->header.stamp.toSec(), pose);
+          wheel->add(odom->header.stamp.toSec(), pose);
       }
     }
   } catch (const rosbag::BagException& ex) {
     std::cerr << "demo_report: " << ex.what() << "\n";
-    return 1;
+    return false;
   }
-  std::sort(scan_stamps.begin(), scan_stamps.end());
-  const std::size_t expected = scan_stamps.size();
+  std::sort(scan_stamps->begin(), scan_stamps->end());
+  return true;
+}
 
-  ros::NodeHandle nh;
-  Received received;
-  ros::Subscriber odom_sub = nh.subscribe<nav_msgs::Odometry>(
-      options.odom_topic, 10000, [&received](const nav_msgs::OdometryConstPtr& msg) {
-        std::lock_guard<std::mutex> lock(received.mutex);
-        received.odometry.push_back(*msg);
-      });
-  ros::Subscriber match_sub = nh.subscribe<hglasm_odometry::Match>(
-      options.match_topic, 10000, [&received](const hglasm_odometry::MatchConstPtr& msg) {
-        std::lock_guard<std::mutex> lock(received.mutex);
-        received.matches.push_back(*msg);
-      });
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-
+/// Waits for the laser odometry's outputs and the paused player, then resumes the player.
+bool startPlayback(const Options& options, const ros::Subscriber& odom_sub, const ros::Subscriber& match_sub,
+                   const ros::WallTime& start) {
   std::printf("[demo] waiting for the laser odometry (%s) ...\n", options.odom_topic.c_str());
   std::fflush(stdout);
-  const ros::WallTime start = ros::WallTime::now();
   while (ros::ok() && (odom_sub.getNumPublishers() == 0 || match_sub.getNumPublishers() == 0)) {
     if ((ros::WallTime::now() - start).toSec() > 60.0) {
       std::cerr << "demo_report: the laser odometry did not come up within 60 s\n";
-      return 1;
+      return false;
     }
     ros::WallDuration(0.1).sleep();
   }
   const std::string pause_service = options.player + "/pause_playback";
   if (!ros::service::waitForService(pause_service, ros::Duration(60.0))) {
     std::cerr << "demo_report: no " << pause_service << " service (is the player running paused?)\n";
-    return 1;
+    return false;
   }
   std_srvs::SetBool resume;
   resume.request.data = false;
   ros::service::call(pause_service, resume);
-  std::printf("[demo] playing %zu scans of %s\n", expected, options.bag.c_str());
-  std::fflush(stdout);
+  return true;
+}
 
-  // Progress until every scan has come out, nothing arrives for 20 s, or the time is up.
+/// Prints progress until every one of `expected` scans has come out, nothing arrives for 20 s, or the
+/// timeout (since `start`) is up.
+void reportProgress(const Options& options, std::size_t expected, const ros::WallTime& start,
+                    Received* received) {
   std::size_t last_count = 0, last_reported = 0;
   ros::WallTime last_progress = ros::WallTime::now();
   while (ros::ok() && (ros::WallTime::now() - start).toSec() < options.timeout) {
     std::size_t count, fallbacks = 0;
     double ms = 0.0;
     {
-      std::lock_guard<std::mutex> lock(received.mutex);
-      count = std::min(received.odometry.size(), received.matches.size());
-      for (const auto& m : received.matches) {
+      std::lock_guard<std::mutex> lock(received->mutex);
+      count = std::min(received->odometry.size(), received->matches.size());
+      for (const auto& m : received->matches) {
         fallbacks += m.fallback && m.matched;
         ms += m.total_ms;
       }
-      if (!received.matches.empty()) ms /= received.matches.size();
+      if (!received->matches.empty()) ms /= received->matches.size();
     }
     if (count >= last_reported + std::max<std::size_t>(1, expected / 10) ||
         (count >= expected && count != last_reported)) {
@@ -185,34 +167,35 @@ int main(int argc, char** argv) {
     }
     ros::WallDuration(0.1).sleep();
   }
-  ros::WallDuration(0.3).sleep();
-  spinner.stop();
-  const double wall = (ros::WallTime::now() - start).toSec();
+}
 
-  std::lock_guard<std::mutex> lock(received.mutex);
+/// The laser odometry's poses, by stamp.
+std::vector<hglasm::StampedPose> laserTrajectory(const std::vector<nav_msgs::Odometry>& odometry) {
   std::vector<hglasm::StampedPose> trajectory;
-  for (const auto& odom : received.odometry) {
+  for (const auto& odom : odometry) {
     hglasm::StampedPose pose;
     pose.stamp = odom.header.stamp.toSec();
     if (hglasm_odometry::pose2DFromOdometryMsg(odom, &pose.pose)) trajectory.push_back(pose);
   }
   std::sort(trajectory.begin(), trajectory.end(),
             [](const hglasm::StampedPose& a, const hglasm::StampedPose& b) { return a.stamp < b.stamp; });
-  // Wheel odometry at the same stamps, started at the laser odometry's first pose for the plot.
-  std::vector<hglasm::StampedPose> wheel_trajectory;
-  hglasm::Pose2D wheel_origin, laser_origin = trajectory.empty() ? hglasm::Pose2D() : trajectory.front().pose;
-  bool have_origin = false;
+  return trajectory;
+}
+
+/// Wheel odometry at the scan stamps (where it reaches them).
+std::vector<hglasm::StampedPose> wheelTrajectory(const hglasm::OdometryBuffer& wheel,
+                                                 const std::vector<double>& scan_stamps) {
+  std::vector<hglasm::StampedPose> trajectory;
   for (double stamp : scan_stamps) {
     hglasm::StampedPose pose;
     pose.stamp = stamp;
-    if (!wheel.poseAt(stamp, 1.0, &pose.pose)) continue;
-    if (!have_origin) {
-      wheel_origin = pose.pose;
-      have_origin = true;
-    }
-    wheel_trajectory.push_back(pose);
+    if (wheel.poseAt(stamp, 1.0, &pose.pose)) trajectory.push_back(pose);
   }
+  return trajectory;
+}
 
+/// Scans, time per scan, fallbacks and keyframes from ~match.
+void printRunSummary(const Options& options, const Received& received, std::size_t expected, double wall) {
   std::vector<double> total_ms;
   std::size_t fallbacks = 0, matched = 0, keyframes = 0;
   std::uint32_t dropped = 0;
@@ -237,25 +220,31 @@ int main(int argc, char** argv) {
   std::printf("  fallbacks           %zu of %zu matches (%.1f %%)\n", fallbacks, matched,
               matched ? 100.0 * fallbacks / matched : 0.0);
   std::printf("  keyframes           %zu\n", keyframes);
+}
 
-  int status = received.odometry.size() == expected ? 0 : 1;
-  if (!options.relations.empty()) {
-    std::vector<hglasm::Relation> relations;
-    std::string error;
-    if (!hglasm::readRelations(options.relations, &relations, &error)) {
-      std::printf("  accuracy            cannot read %s: %s\n", options.relations.c_str(), error.c_str());
-    } else {
-      std::printf("  accuracy vs %zu reference relations (Kümmerle et al. 2009), mean error:\n",
-                  relations.size());
-      std::printf("    %-12s %4s   %-23s   %s\n", "relations", "n", "laser odometry", "wheel odometry (bag)");
-      printAccuracyRow("all", hglasm::evaluateRelations(relations, trajectory, 0.0),
-                       hglasm::evaluateRelations(relations, wheel_trajectory, 0.0));
-      printAccuracyRow("<= 10 s", hglasm::evaluateRelations(relations, trajectory, 10.0),
-                       hglasm::evaluateRelations(relations, wheel_trajectory, 10.0));
-    }
+/// Accuracy of both trajectories against the reference relations (if any were given).
+void printAccuracy(const Options& options, const std::vector<hglasm::StampedPose>& trajectory,
+                   const std::vector<hglasm::StampedPose>& wheel_trajectory) {
+  if (options.relations.empty()) return;
+  std::vector<hglasm::Relation> relations;
+  std::string error;
+  if (!hglasm::readRelations(options.relations, &relations, &error)) {
+    std::printf("  accuracy            cannot read %s: %s\n", options.relations.c_str(), error.c_str());
+    return;
   }
+  std::printf("  accuracy vs %zu reference relations (Kümmerle et al. 2009), mean error:\n",
+              relations.size());
+  std::printf("    %-12s %4s   %-23s   %s\n", "relations", "n", "laser odometry", "wheel odometry (bag)");
+  printAccuracyRow("all", hglasm::evaluateRelations(relations, trajectory, 0.0),
+                   hglasm::evaluateRelations(relations, wheel_trajectory, 0.0));
+  printAccuracyRow("<= 10 s", hglasm::evaluateRelations(relations, trajectory, 10.0),
+                   hglasm::evaluateRelations(relations, wheel_trajectory, 10.0));
+}
 
-  // Trajectories and the gnuplot script of the plot.
+/// The trajectories (the wheels' started at the laser odometry's first pose) and the gnuplot script of
+/// their plot, in options.output_dir.
+void writePlot(const Options& options, const std::vector<hglasm::StampedPose>& trajectory,
+               const std::vector<hglasm::StampedPose>& wheel_trajectory) {
   const std::string dir = options.output_dir;
   {
     std::ofstream out(dir + "/trajectory.txt");
@@ -264,6 +253,9 @@ int main(int argc, char** argv) {
       out << std::fixed << p.stamp << " " << p.pose.x << " " << p.pose.y << " " << p.pose.theta << "\n";
   }
   {
+    const hglasm::Pose2D laser_origin = trajectory.empty() ? hglasm::Pose2D() : trajectory.front().pose;
+    const hglasm::Pose2D wheel_origin =
+        wheel_trajectory.empty() ? hglasm::Pose2D() : wheel_trajectory.front().pose;
     std::ofstream out(dir + "/wheel_odometry.txt");
     out << "# wheel odometry of the bag at the scan stamps, started at the laser odometry's first pose\n";
     for (const auto& p : wheel_trajectory) {
@@ -288,6 +280,52 @@ int main(int argc, char** argv) {
   }
   std::printf("  trajectory          %s/trajectory.txt (plot script %s/trajectory.gp)\n", dir.c_str(),
               dir.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "demo_report", ros::init_options::AnonymousName);
+  Options options;
+  const auto parsed = parseArguments(argc, argv, &options);
+  if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
+
+  // The bag: its scan stamps (what must come out) and wheel odometry (for comparison).
+  std::vector<double> scan_stamps;
+  hglasm::OdometryBuffer wheel(1e9);
+  if (!readBagInputs(options, &scan_stamps, &wheel)) return 1;
+  const std::size_t expected = scan_stamps.size();
+
+  ros::NodeHandle nh;
+  Received received;
+  ros::Subscriber odom_sub = nh.subscribe<nav_msgs::Odometry>(
+      options.odom_topic, 10000, [&received](const nav_msgs::OdometryConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(received.mutex);
+        received.odometry.push_back(*msg);
+      });
+  ros::Subscriber match_sub = nh.subscribe<hglasm_odometry::Match>(
+      options.match_topic, 10000, [&received](const hglasm_odometry::MatchConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(received.mutex);
+        received.matches.push_back(*msg);
+      });
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+
+  const ros::WallTime start = ros::WallTime::now();
+  if (!startPlayback(options, odom_sub, match_sub, start)) return 1;
+  std::printf("[demo] playing %zu scans of %s\n", expected, options.bag.c_str());
+  std::fflush(stdout);
+  reportProgress(options, expected, start, &received);
+  ros::WallDuration(0.3).sleep();
+  spinner.stop();
+  const double wall = (ros::WallTime::now() - start).toSec();
+
+  std::lock_guard<std::mutex> lock(received.mutex);
+  const std::vector<hglasm::StampedPose> trajectory = laserTrajectory(received.odometry);
+  const std::vector<hglasm::StampedPose> wheel_trajectory = wheelTrajectory(wheel, scan_stamps);
+  printRunSummary(options, received, expected, wall);
+  printAccuracy(options, trajectory, wheel_trajectory);
+  writePlot(options, trajectory, wheel_trajectory);
   std::printf("===============================================================\n");
-  return status;
+  return received.odometry.size() == expected ? 0 : 1;
 }

@@ -603,6 +603,67 @@ void printRelations(const Arguments& args, const std::string& preset_name, const
       calibration.mean_sq_mahalanobis, worst_leap);
 }
 
+/// The bag (its laser mount replaced by --laser-mount if given) and the relations, with a line on each.
+bool readInputs(const Arguments& args, const std::string& base_frame, hglasm_odometry::BagData* data,
+                std::vector<hglasm::Relation>* relations) {
+  hglasm_odometry::BagReadOptions read_options;
+  read_options.scan_topic = args.scan_topic;
+  read_options.odom_topic = args.odom_topic;
+  read_options.max_scans = args.max_scans;
+  read_options.base_frame = base_frame;
+  std::string error;
+  const double read_start = cpuMs();
+  if (!hglasm_odometry::readBag(args.bag, read_options, data, &error)) {
+    std::cerr << "evaluate: " << error << "\n";
+    return false;
+  }
+  if (!args.relations.empty() && !hglasm::readRelations(args.relations, relations, &error)) {
+    std::cerr << "evaluate: " << error << "\n";
+    return false;
+  }
+  std::printf("bag           %s: %zu scans, %zu odometry samples (read in %.1f s CPU)\n", args.bag.c_str(),
+              data->scans.size(), data->odometry.size(), (cpuMs() - read_start) * 1e-3);
+  const char* mount_source = data->has_laser_mount ? "from tf" : "not found, identity";
+  if (args.override_mount) {
+    data->has_laser_mount = true;
+    data->base_to_laser = args.laser_mount;
+    mount_source = "from --laser-mount";
+  }
+  std::printf("laser mount   %s: base '%s' -> laser '%s' = (%.3f, %.3f, %.3f rad)%s\n", mount_source,
+              data->base_frame.c_str(), data->scans.front().frame_id.c_str(), data->base_to_laser.x,
+              data->base_to_laser.y, data->base_to_laser.theta,
+              data->laser_upside_down ? ", upside down (scans mirrored)" : "");
+  return true;
+}
+
+/// --out, --trace and --plot, each if asked for.
+bool writeOutputs(const Arguments& args, const std::string& preset, const Run& run,
+                  const std::vector<hglasm::StampedPose>& wheel_trajectory) {
+  if (!args.out.empty()) {
+    if (!writeTrajectory(args.out, run.trajectory, &run.updates)) {
+      std::cerr << "evaluate: cannot write " << args.out << "\n";
+      return false;
+    }
+    std::printf("trajectory    %s (%zu poses)\n", args.out.c_str(), run.trajectory.size());
+  }
+  if (!args.trace.empty()) {
+    if (!writeTrace(args.trace, run.updates)) {
+      std::cerr << "evaluate: cannot write " << args.trace << "\n";
+      return false;
+    }
+    std::printf("trace         %s\n", args.trace.c_str());
+  }
+  if (!args.plot.empty()) {
+    const std::string title = args.bag.substr(args.bag.find_last_of('/') + 1) + ", preset " + preset;
+    if (!plotTrajectories(args.plot, title, run.trajectory, wheel_trajectory)) {
+      std::cerr << "evaluate: gnuplot failed for " << args.plot << "\n";
+      return false;
+    }
+    std::printf("plot          %s\n", args.plot.c_str());
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -627,34 +688,9 @@ int main(int argc, char** argv) {
   hglasm::TrackerOptions options = nodelet_options.tracker;
   if (!args.use_odometry) options.use_odometry = false;
 
-  hglasm_odometry::BagReadOptions read_options;
-  read_options.scan_topic = args.scan_topic;
-  read_options.odom_topic = args.odom_topic;
-  read_options.max_scans = args.max_scans;
-  read_options.base_frame = nodelet_options.base_frame;
   hglasm_odometry::BagData data;
-  const double read_start = cpuMs();
-  if (!hglasm_odometry::readBag(args.bag, read_options, &data, &error)) {
-    std::cerr << "evaluate: " << error << "\n";
-    return 1;
-  }
   std::vector<hglasm::Relation> relations;
-  if (!args.relations.empty() && !hglasm::readRelations(args.relations, &relations, &error)) {
-    std::cerr << "evaluate: " << error << "\n";
-    return 1;
-  }
-  std::printf("bag           %s: %zu scans, %zu odometry samples (read in %.1f s CPU)\n", args.bag.c_str(),
-              data.scans.size(), data.odometry.size(), (cpuMs() - read_start) * 1e-3);
-  const char* mount_source = data.has_laser_mount ? "from tf" : "not found, identity";
-  if (args.override_mount) {
-    data.has_laser_mount = true;
-    data.base_to_laser = args.laser_mount;
-    mount_source = "from --laser-mount";
-  }
-  std::printf("laser mount   %s: base '%s' -> laser '%s' = (%.3f, %.3f, %.3f rad)%s\n", mount_source,
-              data.base_frame.c_str(), data.scans.front().frame_id.c_str(), data.base_to_laser.x,
-              data.base_to_laser.y, data.base_to_laser.theta,
-              data.laser_upside_down ? ", upside down (scans mirrored)" : "");
+  if (!readInputs(args, nodelet_options.base_frame, &data, &relations)) return 1;
   std::printf("options       %s, preset %s, wheel odometry %s\n", args.config.c_str(),
               nodelet_options.preset.c_str(),
               !options.use_odometry   ? "off"
@@ -673,28 +709,5 @@ int main(int argc, char** argv) {
   if (!relations.empty())
     printRelations(args, nodelet_options.preset, run, relations, wheel_trajectory, options, data);
 
-  if (!args.out.empty()) {
-    if (!writeTrajectory(args.out, run.trajectory, &run.updates)) {
-      std::cerr << "evaluate: cannot write " << args.out << "\n";
-      return 1;
-    }
-    std::printf("trajectory    %s (%zu poses)\n", args.out.c_str(), run.trajectory.size());
-  }
-  if (!args.trace.empty()) {
-    if (!writeTrace(args.trace, run.updates)) {
-      std::cerr << "evaluate: cannot write " << args.trace << "\n";
-      return 1;
-    }
-    std::printf("trace         %s\n", args.trace.c_str());
-  }
-  if (!args.plot.empty()) {
-    const std::string title =
-        args.bag.substr(args.bag.find_last_of('/') + 1) + ", preset " + nodelet_options.preset;
-    if (!plotTrajectories(args.plot, title, run.trajectory, wheel_trajectory)) {
-      std::cerr << "evaluate: gnuplot failed for " << args.plot << "\n";
-      return 1;
-    }
-    std::printf("plot          %s\n", args.plot.c_str());
-  }
-  return 0;
+  return writeOutputs(args, nodelet_options.preset, run, wheel_trajectory) ? 0 : 1;
 }

@@ -151,6 +151,25 @@ TEST(GeneticAligner, FitnessAndRatioDescribeTheReturnedPose) {
   EXPECT_LE(result.fitness_ratio, 1.0);
 }
 
+TEST(GeneticAligner, EveryGenerationCoarseStillReportsTheFineFitness) {
+  // With coarse_generations == generations no generation is scored on the fine table: the final
+  // population's coarse scores must not compete with the guess's fine one, nor be reported.
+  const RoomFixture room(hglasm_test::halfCircleLaser());
+  const auto scan = room.scanAt(Pose2D(0.1, 0.2, -0.1));
+  for (int generations : {1, 3, 6}) {
+    GeneticOptions options = presetGenetic(hglasm::Preset::kSmall, 3);
+    options.max_points = 0;  // fitness over all points
+    options.generations = generations;
+    options.coarse_generations = generations;
+    GeneticAligner aligner(options);
+    const PreAlignResult result = aligner.align(room.table(), scan.points, Pose2D(), nullptr, room.coarse());
+    EXPECT_EQ(result.fitness, room.table().fitness(scan.points, result.pose))
+        << generations << " generations";
+    EXPECT_NEAR(result.fitness_ratio, result.fitness / (255.0 * scan.size()), 1e-12);
+    EXPECT_LE(result.fitness_ratio, 1.0);
+  }
+}
+
 TEST(GeneticAligner, SameSeedGivesIdenticalResults) {
   const RoomFixture room(hglasm_test::halfCircleLaser());
   const auto scan = room.scanAt(Pose2D(0.5, -0.3, 0.6));

@@ -195,7 +195,7 @@ TEST(PgaScanMatcher, HybridRefinesToTheTruthAndIsDeterministicPerSeed) {
   EXPECT_TRUE(pga.ok());
   EXPECT_LT(hglasm_test::translationError(pga.pose, truth), kPrealignXy);
   EXPECT_LT(hglasm_test::rotationError(pga.pose, truth), kPrealignTheta);
-  EXPECT_GT(pga.fitness_ratio, 0.5);
+  EXPECT_GT(pga.prealigned_fitness_ratio, 0.5);
   EXPECT_GT(pga.evaluations, 100 * 9);
   EXPECT_EQ(hpga.iterations > 0, true);
   EXPECT_LT(hglasm_test::translationError(hpga.pose, truth), 0.01);
@@ -203,16 +203,16 @@ TEST(PgaScanMatcher, HybridRefinesToTheTruthAndIsDeterministicPerSeed) {
   // The hybrid's GA stage is PGA's, seed for seed.
   EXPECT_EQ(hpga.prealigned_pose.x, pga.prealigned_pose.x);
   EXPECT_EQ(hpga.prealigned_pose.theta, pga.prealigned_pose.theta);
-  EXPECT_EQ(hpga.fitness, pga.fitness);
+  EXPECT_EQ(hpga.prealigned_fitness, pga.prealigned_fitness);
   // Same seed, same result; another seed, another search.
   const hglasm::MatchResult again = matchWith(hglasm::Algorithm::kPga, 3, truth);
   EXPECT_EQ(again.prealigned_pose.x, pga.prealigned_pose.x);
   EXPECT_EQ(again.prealigned_pose.y, pga.prealigned_pose.y);
-  EXPECT_EQ(again.fitness, pga.fitness);
+  EXPECT_EQ(again.prealigned_fitness, pga.prealigned_fitness);
   EXPECT_EQ(again.evaluations, pga.evaluations);
   const hglasm::MatchResult other = matchWith(hglasm::Algorithm::kPga, 4, truth);
-  EXPECT_FALSE(other.prealigned_pose.x == pga.prealigned_pose.x && other.fitness == pga.fitness &&
-               other.evaluations == pga.evaluations);
+  EXPECT_FALSE(other.prealigned_pose.x == pga.prealigned_pose.x &&
+               other.prealigned_fitness == pga.prealigned_fitness && other.evaluations == pga.evaluations);
 }
 
 TEST(PgaScanMatcher, AlgorithmNamesParse) {

@@ -58,8 +58,8 @@ std::string describe(const TrackerUpdate& u) {
   std::ostringstream text;
   text << "stamp " << u.stamp << " pose " << u.pose.x << " " << u.pose.y << " " << u.pose.theta << " matched "
        << u.matched << " fallback " << u.fallback << " status " << hglasm::toString(u.match.status)
-       << " fitness " << u.match.fitness_ratio << " prediction " << hglasm::toString(u.prediction)
-       << " keyframe " << u.new_keyframe << " reset " << u.reset << " warning '" << u.warning << "'";
+       << " fitness " << u.fitness_ratio << " prediction " << hglasm::toString(u.prediction) << " keyframe "
+       << u.new_keyframe << " reset " << u.reset << " warning '" << u.warning << "'";
   return text.str();
 }
 

@@ -29,7 +29,7 @@ std::string describe(const MatchResult& result) {
   text << "pose " << result.pose.x << " " << result.pose.y << " " << result.pose.theta << ", prealigned "
        << result.prealigned_pose.x << " " << result.prealigned_pose.y << " " << result.prealigned_pose.theta
        << ", status " << hglasm::toString(result.status) << ", mbicp "
-       << hglasm::toString(result.mbicp_status) << ", fitness ratio " << result.fitness_ratio
+       << hglasm::toString(result.mbicp_status) << ", fitness ratio " << result.prealigned_fitness_ratio
        << ", evaluations " << result.evaluations << ", iterations " << result.iterations;
   return text.str();
 }
@@ -38,9 +38,9 @@ void expectFinite(const MatchResult& result) {
   EXPECT_TRUE(result.pose.isFinite()) << describe(result);
   EXPECT_TRUE(result.prealigned_pose.isFinite()) << describe(result);
   EXPECT_TRUE(hglasm_test::isValidCovariance(result.covariance)) << result.covariance;
-  EXPECT_TRUE(std::isfinite(result.fitness_ratio));
-  EXPECT_GE(result.fitness_ratio, 0.0);
-  EXPECT_LE(result.fitness_ratio, 1.0);
+  EXPECT_TRUE(std::isfinite(result.prealigned_fitness_ratio));
+  EXPECT_GE(result.prealigned_fitness_ratio, 0.0);
+  EXPECT_LE(result.prealigned_fitness_ratio, 1.0);
   EXPECT_TRUE(std::isfinite(result.rms_error));
   EXPECT_TRUE(std::isfinite(result.prealign_ms) && result.prealign_ms >= 0.0);
   EXPECT_TRUE(std::isfinite(result.refine_ms) && result.refine_ms >= 0.0);
@@ -147,7 +147,7 @@ TEST(ScanMatcher, EveryAlgorithmRecoversAKnownPose) {
       }
       if (genetic) {
         EXPECT_GT(result.evaluations, 0);
-        EXPECT_GT(result.fitness, 0u);
+        EXPECT_GT(result.prealigned_fitness, 0u);
       } else {
         EXPECT_EQ(result.evaluations, 0);
         EXPECT_EQ(result.prealigned_pose.x, 0.0);  // no GA: the guess is the pre-aligned pose
@@ -225,7 +225,7 @@ TEST(ScanMatcher, SameSeedSameResult) {
   EXPECT_EQ(first.pose.x, second.pose.x);
   EXPECT_EQ(first.pose.y, second.pose.y);
   EXPECT_EQ(first.pose.theta, second.pose.theta);
-  EXPECT_EQ(first.fitness, second.fitness);
+  EXPECT_EQ(first.prealigned_fitness, second.prealigned_fitness);
 }
 
 TEST(ScanMatcher, TableIsBuiltOncePerReferenceForGeneticAlgorithms) {

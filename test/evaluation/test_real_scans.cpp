@@ -100,7 +100,7 @@ Tally oddEvenTrials(const std::vector<Scan>& scans, Preset preset, Algorithm alg
         std::ostringstream text;
         text << "\n  scan " << s << " offset " << truth.x << " " << truth.y << " " << truth.theta
              << ": error " << dxy << " m " << dth << " rad, status " << hglasm::toString(result.status)
-             << ", fitness " << result.fitness_ratio;
+             << ", fitness " << result.prealigned_fitness_ratio;
         tally.misses += text.str();
       }
     }
@@ -251,7 +251,7 @@ void consecutiveScans(const std::string& scans_name, const std::string& relation
     ++pairs;
     EXPECT_TRUE(result.pose.isFinite()) << scans_name << " pair " << i;
     EXPECT_TRUE(hglasm_test::isValidCovariance(result.covariance)) << scans_name << " pair " << i;
-    EXPECT_TRUE(std::isfinite(result.fitness_ratio) && std::isfinite(result.rms_error));
+    EXPECT_TRUE(std::isfinite(result.prealigned_fitness_ratio) && std::isfinite(result.rms_error));
     EXPECT_TRUE(result.ok()) << scans_name << " pair " << i << ": " << hglasm::toString(result.status);
     if (result.ok()) ++ok;
     if (!on_chain[i]) on_chain[i] = true;  // the block's first scan is the origin of the chain
@@ -303,8 +303,8 @@ TEST(RealScans, ConsecutiveCcnyScansGiveFiniteResults) {
     const MatchResult result = matcher.match(ccny[i + 1], Pose2D());
     EXPECT_TRUE(result.pose.isFinite());
     EXPECT_TRUE(hglasm_test::isValidCovariance(result.covariance));
-    EXPECT_GE(result.fitness_ratio, 0.0);
-    EXPECT_LE(result.fitness_ratio, 1.0);
+    EXPECT_GE(result.prealigned_fitness_ratio, 0.0);
+    EXPECT_LE(result.prealigned_fitness_ratio, 1.0);
   }
 }
 

@@ -54,8 +54,8 @@ void checkFinite(const hglasm::MatchResult& result) {
   check(result.pose.isFinite());
   check(result.prealigned_pose.isFinite());
   check(result.covariance.allFinite());
-  check(std::isfinite(result.fitness_ratio) && result.fitness_ratio >= 0.0 &&
-        result.fitness_ratio <= 1.0 + 1e-9);
+  check(std::isfinite(result.prealigned_fitness_ratio) && result.prealigned_fitness_ratio >= 0.0 &&
+        result.prealigned_fitness_ratio <= 1.0 + 1e-9);
 }
 
 }  // namespace

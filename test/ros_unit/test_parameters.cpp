@@ -56,7 +56,6 @@ TEST(Parameters, NoParametersGiveTheMediumPresetAndDefaults) {
   EXPECT_EQ(options.odom_frame, "odom");
   EXPECT_EQ(options.base_frame, "base_link");
   EXPECT_TRUE(options.publish_tf);
-  EXPECT_TRUE(options.use_odom);
   EXPECT_TRUE(options.tracker.use_odometry);
   EXPECT_FALSE(options.publish_population);
   EXPECT_GE(options.queue_size, 1);
@@ -94,7 +93,6 @@ TEST(Parameters, PresetsYamlThenTopLevelOverridesWin) {
   EXPECT_DOUBLE_EQ(options.tracker.matcher.genetic.box.half_x, 0.5);  // top level beats the preset
   EXPECT_DOUBLE_EQ(options.tracker.keyframe_distance, 0.7);
   EXPECT_EQ(options.odom_frame, "laser_odom");  // leading slash stripped
-  EXPECT_FALSE(options.use_odom);
   EXPECT_FALSE(options.tracker.use_odometry);
 }
 
@@ -148,6 +146,11 @@ TEST(Parameters, OutOfRangeValuesNameTheParameter) {
   EXPECT_NE(loadError(params({{"min_fitness", -0.1}})).find("~min_fitness"), std::string::npos);
   EXPECT_NE(loadError(params({{"genetic/bits_per_gene", 40}})).find("~genetic/bits_per_gene"),
             std::string::npos);
+  // The GA keeps at least its best individual: 0 elites is refused, not quietly made 1.
+  EXPECT_EQ(loadError(params({{"genetic/elite_count", 0}})),
+            "parameter ~genetic/elite_count must be an integer in [1, 100000], got 0");
+  EXPECT_EQ(loadError(params({{"presets/medium/genetic/elite_count", 0}})),
+            "parameter ~presets/medium/genetic/elite_count must be an integer in [1, 100000], got 0");
   EXPECT_NE(loadError(params({{"genetic/tournament_size", 30}, {"genetic/population", 20}}))
                 .find("~genetic/tournament_size"),
             std::string::npos);
@@ -270,6 +273,33 @@ TEST(Parameters, UnknownKeysAreWarningsNotErrors) {
   ASSERT_EQ(warnings.size(), 2u);
   EXPECT_NE(warnings[0].find("~presets/medium/genetic/generatons"), std::string::npos) << warnings[0];
   EXPECT_NE(warnings[1].find("~genetic/populaton"), std::string::npos) << warnings[1];
+}
+
+TEST(Parameters, ToParamsIsWhatLoadOptionsReadsBack) {
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(params({{"preset", "large"},
+                                  {"algorithm", "glasm_binary"},
+                                  {"genetic/elite_count", 2},
+                                  {"genetic/seed", 77},
+                                  {"mbicp/point_to_line", false},
+                                  {"scan/max_range", 12.5},
+                                  {"use_odom", false},
+                                  {"base_frame", "/base"}}),
+                          &options, &error))
+      << error;
+  XmlRpcValue written = toParams(options);
+  EXPECT_EQ(static_cast<std::string>(written["algorithm"]), "glasm_binary");
+  EXPECT_EQ(static_cast<int>(written["genetic"]["elite_count"]), 2);
+  EXPECT_EQ(static_cast<bool>(written["use_odom"]), false);
+  EXPECT_EQ(static_cast<std::string>(written["base_frame"]), "base");
+  std::vector<std::string> warnings;
+  LaserOdometryOptions again;
+  ASSERT_TRUE(loadOptions(written, &again, &error, &warnings)) << error;
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_TRUE(toParams(again) == written);
+  EXPECT_EQ(again.tracker.matcher.genetic.seed, 77u);
+  EXPECT_DOUBLE_EQ(again.tracker.matcher.genetic.box.half_theta, M_PI);  // large's, written out
 }
 
 TEST(Parameters, SummaryMentionsThePresetAndFrames) {

@@ -43,11 +43,11 @@
 #include "hglasm_odometry/Match.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
 #include "hglasm_odometry/core/odometry_pipeline.h"
+#include "hglasm_odometry/core/relations.h"
 #include "hglasm_odometry/core/scan_matcher.h"
-#include "hglasm_odometry/evaluation/relations.h"
+#include "hglasm_odometry/ros/bag_reader.h"
 #include "hglasm_odometry/ros/conversions.h"
 #include "hglasm_odometry/ros/parameters.h"
-#include "hglasm_odometry/tools/bag_reader.h"
 
 namespace hglasm_odometry {
 namespace {
@@ -380,7 +380,7 @@ std::map<double, OfflineScan> runOffline(const Settings& settings) {
   EXPECT_TRUE(loadOptions(ros::NodeHandle(settings.odometry_ns), &options, &error, &warnings)) << error;
   BagReadOptions read_options;
   read_options.scan_topic = settings.scan_topic;
-  read_options.odom_topic = options.use_odom ? settings.wheel_odom_topic : "";
+  read_options.odom_topic = options.tracker.use_odometry ? settings.wheel_odom_topic : "";
   read_options.base_frame = options.base_frame;
   BagData data;
   EXPECT_TRUE(readBag(settings.bag, read_options, &data, &error)) << error;
@@ -464,8 +464,9 @@ TEST_F(OdometryReplay, OfflinePipelineGivesTheSameTrajectory) {
   EXPECT_LE(max_guess, kTolerance) << "Match.guess_pose";
 }
 
-/// config/presets.yaml (loaded by the launch file under the odometry's ~presets) must carry exactly the
-/// built-in values of hglasm::presetOptions, and the shipped YAML must validate for every preset.
+/// config/presets.yaml, as the launch file loaded it under the odometry's ~presets, carries exactly the
+/// built-in values of hglasm::presetOptions, and the shipped YAML validates for every preset (field by
+/// field against the YAML files themselves: test_shipped_yaml).
 TEST_F(OdometryReplay, ShippedYamlValidatesAndMatchesTheBuiltInPresets) {
   XmlRpc::XmlRpcValue params;
   ASSERT_TRUE(ros::NodeHandle().getParam(recording_->settings.odometry_ns, params));
@@ -474,7 +475,9 @@ TEST_F(OdometryReplay, ShippedYamlValidatesAndMatchesTheBuiltInPresets) {
   for (const char* name : {"small", "medium", "large"}) {
     hglasm::Preset preset;
     ASSERT_TRUE(hglasm::parsePreset(name, &preset));
-    const hglasm::MatcherOptions expected = hglasm::presetOptions(preset);
+    LaserOdometryOptions expected;
+    expected.preset = name;
+    expected.tracker.matcher = hglasm::presetOptions(preset);
     for (XmlRpc::XmlRpcValue* root : {&params, &presets_only}) {
       (*root)["preset"] = name;
       LaserOdometryOptions options;
@@ -483,50 +486,8 @@ TEST_F(OdometryReplay, ShippedYamlValidatesAndMatchesTheBuiltInPresets) {
       ASSERT_TRUE(loadOptions(*root, &options, &error, &warnings)) << error;
       EXPECT_TRUE(warnings.empty()) << warnings.front();
       if (root != &presets_only) continue;
-      const hglasm::MatcherOptions& got = options.tracker.matcher;
-      const hglasm::GeneticOptions &g = got.genetic, &e = expected.genetic;
-      EXPECT_EQ(got.algorithm, expected.algorithm) << name;
-      EXPECT_DOUBLE_EQ(g.box.half_x, e.box.half_x) << name;
-      EXPECT_DOUBLE_EQ(g.box.half_y, e.box.half_y) << name;
-      EXPECT_DOUBLE_EQ(g.box.half_theta, e.box.half_theta) << name;
-      EXPECT_EQ(g.population, e.population) << name;
-      EXPECT_EQ(g.generations, e.generations) << name;
-      EXPECT_EQ(g.runs, e.runs) << name;
-      EXPECT_EQ(g.bits_per_gene, e.bits_per_gene) << name;
-      EXPECT_DOUBLE_EQ(g.crossover_rate, e.crossover_rate) << name;
-      EXPECT_DOUBLE_EQ(g.mutation_rate, e.mutation_rate) << name;
-      EXPECT_EQ(g.tournament_size, e.tournament_size) << name;
-      EXPECT_EQ(g.elite_count, e.elite_count) << name;
-      EXPECT_EQ(g.max_points, e.max_points) << name;
-      EXPECT_EQ(g.polish_evaluations, e.polish_evaluations) << name;
-      EXPECT_EQ(g.coarse_generations, e.coarse_generations) << name;
-      EXPECT_EQ(g.seed, e.seed) << name;
-      for (int t = 0; t < 2; ++t) {
-        const hglasm::LookupTableOptions& a = t == 0 ? got.table : got.coarse_table;
-        const hglasm::LookupTableOptions& b = t == 0 ? expected.table : expected.coarse_table;
-        EXPECT_DOUBLE_EQ(a.cell_size, b.cell_size) << name << " table " << t;
-        EXPECT_DOUBLE_EQ(a.sigma, b.sigma) << name << " table " << t;
-        EXPECT_DOUBLE_EQ(a.cutoff, b.cutoff) << name << " table " << t;
-        EXPECT_DOUBLE_EQ(a.segment_max_gap, b.segment_max_gap) << name << " table " << t;
-        EXPECT_DOUBLE_EQ(a.segment_max_incidence, b.segment_max_incidence) << name << " table " << t;
-        EXPECT_DOUBLE_EQ(a.isolated_footprint, b.isolated_footprint) << name << " table " << t;
-      }
-      const hglasm::MbicpOptions &m = got.mbicp, &n = expected.mbicp;
-      EXPECT_DOUBLE_EQ(m.metric_l, n.metric_l) << name;
-      EXPECT_DOUBLE_EQ(m.bearing_window, n.bearing_window) << name;
-      EXPECT_DOUBLE_EQ(m.max_distance, n.max_distance) << name;
-      EXPECT_DOUBLE_EQ(m.segment_max_gap, n.segment_max_gap) << name;
-      EXPECT_DOUBLE_EQ(m.segment_max_incidence, n.segment_max_incidence) << name;
-      EXPECT_DOUBLE_EQ(m.robust_scale, n.robust_scale) << name;
-      EXPECT_DOUBLE_EQ(m.point_noise, n.point_noise) << name;
-      EXPECT_EQ(m.max_iterations, n.max_iterations) << name;
-      EXPECT_DOUBLE_EQ(m.error_ratio, n.error_ratio) << name;
-      EXPECT_DOUBLE_EQ(m.min_step_xy, n.min_step_xy) << name;
-      EXPECT_DOUBLE_EQ(m.min_step_theta, n.min_step_theta) << name;
-      EXPECT_EQ(m.converged_iterations, n.converged_iterations) << name;
-      EXPECT_DOUBLE_EQ(m.min_association_ratio, n.min_association_ratio) << name;
-      EXPECT_DOUBLE_EQ(m.degenerate_eigenvalue, n.degenerate_eigenvalue) << name;
-      EXPECT_EQ(m.point_to_line, n.point_to_line) << name;
+      XmlRpc::XmlRpcValue got = toParams(options), want = toParams(expected);
+      EXPECT_TRUE(got == want) << name << ":\n" << got.toXml() << "\nexpected\n" << want.toXml();
     }
   }
 }

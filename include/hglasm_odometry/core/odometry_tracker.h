@@ -4,14 +4,15 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "hglasm_odometry/core/keyframe_policy.h"
 #include "hglasm_odometry/core/local_map.h"
 #include "hglasm_odometry/core/motion_model.h"
-#include "hglasm_odometry/core/odometry_buffer.h"
 #include "hglasm_odometry/core/pose2d.h"
+#include "hglasm_odometry/core/pose_extrapolator.h"
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
 
@@ -24,8 +25,8 @@ struct TrackerOptions {
   MotionNoiseOptions motion;
   double keyframe_distance = 0.30;    ///< metres moved since the keyframe that make a new keyframe
   double keyframe_angle = 0.20;       ///< radians turned since the keyframe that make a new keyframe
-  double keyframe_min_fitness = 0.0;  ///< a match below this fitness ratio makes the scan a keyframe
-  double min_fitness = 0.15;          ///< a match whose pose scores below this fitness ratio has failed
+  double keyframe_min_fitness = 0.0;  ///< a published pose below this fitness ratio makes the scan a keyframe
+  double min_fitness = 0.15;          ///< a match whose pose is below this fitness ratio has failed
   int min_points = 20;                ///< scans with fewer valid points are not matched
   double fallback_covariance_scale = 100.0;  ///< covariance inflation of a step whose match failed
   double odometry_max_extrapolation = 0.25;  ///< seconds; beyond, wheel odometry counts as stale
@@ -72,9 +73,6 @@ struct TrackerOptions {
 /// The variance published for what is not known (a covariance must stay finite).
 constexpr double kUnknownVariance = 1e4;
 
-enum class PredictionSource { kOdometry, kConstantVelocity, kNone };
-const char* toString(PredictionSource source);
-
 /// What happened to one scan.
 struct TrackerUpdate {
   double stamp = 0.0;
@@ -88,9 +86,13 @@ struct TrackerUpdate {
   /// Unknown (kUnknownVariance on the diagonal) until the velocity has a baseline: the first scans, after
   /// a reset.
   Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Identity() * kUnknownVariance;
-  MatchResult match;           ///< raw matcher output (laser frame, local map's frame)
-  double fitness_ratio = 0.0;  ///< fitness ratio of the scan at the estimated pose (fine table)
-  Pose2D guess;                ///< predicted pose of the base (odometry frame) before matching
+  MatchResult match;  ///< raw matcher output (laser frame, local map's frame)
+  /// How well the scan fits the local map at the published pose: the cells its points hit on the fine
+  /// graded table / (255 * points), 1 = every point on the map; whatever the algorithm, the ratio
+  /// min_fitness, keyframe_min_fitness and the doubt about the prediction judge. 0 without a map or a usable
+  /// scan.
+  double fitness_ratio = 0.0;
+  Pose2D guess;  ///< predicted pose of the base (odometry frame) before matching
   PredictionSource prediction = PredictionSource::kNone;
   SearchEffort search;              ///< box and GA size the scan was searched with
   double prior_mahalanobis = 0.0;   ///< Mahalanobis distance of the match from the prediction
@@ -127,7 +129,7 @@ class OdometryTracker {
   TrackerUpdate processScan(double stamp, const Scan& scan, std::vector<Pose2D>* population_out = nullptr);
 
   /// Makes the next processed scan a keyframe (e.g. the scanner's geometry changed).
-  void requestKeyframe() { keyframe_requested_ = true; }
+  void requestKeyframe() { keyframes_.request(); }
 
   /// Restarts from the identity pose with an empty map (odometry history and learned noise kept).
   void reset();
@@ -138,13 +140,6 @@ class OdometryTracker {
   const LocalMap& localMap() const { return local_map_; }
 
  private:
-  /// The predicted motion of the base since the last scan, in the base frame, and its noise.
-  struct Prediction {
-    PredictionSource source = PredictionSource::kNone;
-    Pose2D motion;
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-    Eigen::Matrix3d nominal_covariance = Eigen::Matrix3d::Zero();  ///< wheels at unit noise scale
-  };
   /// The new pose: the laser in the local map's frame, with its covariance there, and the covariance of
   /// the base's increment since the last scan.
   struct Estimate {
@@ -175,7 +170,7 @@ class OdometryTracker {
   };
 
   bool handleTime(double stamp, TrackerUpdate* update);
-  Hypotheses hypothesesFor(const Prediction& prediction) const;
+  Hypotheses hypothesesFor(const MotionPrediction& prediction) const;
   /// log posterior of a match under each hypothesis (up to a common constant).
   void scoreHypotheses(const Scan& scan, const Hypotheses& h, const MatchResult& match, double* holds,
                        double* wrong) const;
@@ -185,22 +180,27 @@ class OdometryTracker {
   /// The new pose and its covariances from the chosen match.
   void estimateFrom(const Candidate& chosen, const Hypotheses& h, Estimate* estimate) const;
   void initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update);
-  Prediction predict(double stamp, std::string* warning) const;
   /// Match against the local map with the prediction as prior; false if the prediction is integrated.
-  bool matchScan(const Scan& scan, const Prediction& prediction, std::vector<Pose2D>* population_out,
+  bool matchScan(const Scan& scan, const MotionPrediction& prediction, std::vector<Pose2D>* population_out,
                  TrackerUpdate* update, Estimate* estimate);
   SearchEffort searchEffort(const Eigen::Matrix3d& prior_covariance, bool have_prior) const;
   Candidate evaluate(const Scan& scan, const MatchResult& match, const PosePrior& prior) const;
   /// Whether the tight match (or the scan alone) disagrees with the prediction beyond its noise.
   bool predictionInDoubt(const Candidate& tight, const PosePrior& prior,
                          const Eigen::Matrix3d& prior_covariance) const;
-  /// log p(scan | pose), of the scan's independent points (on the lookup table as a likelihood field).
+  /// log p(scan | pose), of the scan's independent points (on the judging table as a likelihood field).
   double scanLogLikelihood(const Scan& scan, const Pose2D& pose) const;
+  /// The fitness ratio of `scan` at `pose` (local map's frame) on the judging table.
+  double fitnessRatioAt(const Scan& scan, const Pose2D& pose) const;
+  /// The fine graded table of the local map that scans are judged on: the matcher's own where it is one
+  /// (hglasm_g, glasm_g), else own_table_ (binary tables, MbICP and PGA alone have none), so that one
+  /// yardstick judges every algorithm.
+  const LookupTable& judgingTable() const { return own_table_ ? *own_table_ : matcher_.table(); }
   /// log of the normal density of `pose` under a prior.
   static double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3d& covariance);
   /// Learns the wheels' noise from the wheel increment against the scans' own increment.
-  void learnNoise(const Prediction& prediction, const MatchResult& match);
-  Estimate integratePrediction(const Prediction& prediction) const;
+  void learnNoise(const MotionPrediction& prediction, const MatchResult& match);
+  Estimate integratePrediction(const MotionPrediction& prediction) const;
   void updateVelocity(double stamp, const Pose2D& new_pose, TrackerUpdate* update);
   void updateKeyframe(const Scan& scan, bool usable, TrackerUpdate* update);
   void addKeyframe(const Scan& scan);
@@ -210,7 +210,10 @@ class OdometryTracker {
 
   TrackerOptions options_;
   ScanMatcher matcher_;
-  OdometryBuffer odometry_;
+  std::optional<LookupTable> own_table_;  // see judgingTable()
+  double table_build_ms_ = 0.0;           // of the tables of the newest keyframe's map
+  PoseExtrapolator extrapolator_;
+  KeyframePolicy keyframes_;
   MotionNoiseModel noise_;
   LocalMap local_map_;
   Pose2D laser_mount_;
@@ -220,8 +223,6 @@ class OdometryTracker {
   Pose2D pose_;
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d map_covariance_ = Eigen::Matrix3d::Zero();  // of the laser pose in the local map's frame
-  Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
-  bool velocity_valid_ = false;
   double prediction_wrong_ = 0.0;  // probability that the last scan's prediction was wrong (a leap)
   /// Mean and variance of recent values, exponentially forgotten.
   struct RunningStats {
@@ -234,11 +235,7 @@ class OdometryTracker {
   bool have_scan_only_pose_ = false;
   Pose2D scan_only_pose_;  // base pose in the odometry frame where the last scan alone put it
 
-  std::deque<StampedPose> history_;  // recent poses, for the velocity
-  bool keyframe_requested_ = false;
   int keyframe_id_ = 0;
-  int keyframe_beam_count_ = 0;
-  Pose2D keyframe_pose_;  // base pose of the newest keyframe
 };
 
 }  // namespace hglasm

@@ -41,23 +41,32 @@ bool parsePreset(const std::string& name, Preset* preset);
 /// The coarse table's defaults: a wider basin than the fine table's.
 inline LookupTableOptions coarseTableOptions() {
   LookupTableOptions options;
-  options.cell_size = 0.06;
+  options.cell_size = 0.08;
   options.sigma = 0.30;
   options.cutoff = 0.60;
   return options;
 }
 
+/// The defaults are the medium preset (the default ~preset), as config/presets.yaml documents it.
 struct MatcherOptions {
   Algorithm algorithm = Algorithm::kHglasmG;
   LookupTableOptions table;  ///< `kind` is overridden by the algorithm
   /// Table for the GA's first genetic.coarse_generations generations (same kind as `table`).
   LookupTableOptions coarse_table = coarseTableOptions();
   GeneticOptions genetic;
-  MbicpOptions mbicp;
+  /// Measured (README): the information of at most 100 independent points (intel, fr079, aces: with 50 the
+  /// fused odometry leans on the wheels where the scans know better, with 200 it takes the scans'
+  /// look-alike leaps). MbicpOptions' robust weights, surfaces and point noise: see its fields.
+  MbicpOptions mbicp = [] {
+    MbicpOptions measured;
+    measured.independent_points = 100.0;
+    return measured;
+  }();
   PolarPairingOptions pga;  ///< PGA / HPGA only
 };
 
-/// Built-in defaults of each preset (config/presets.yaml holds the same values for ROS users).
+/// Each preset: the defaults above with the search space of the papers' Table 1 (config/presets.yaml holds
+/// the same values for ROS users).
 MatcherOptions presetOptions(Preset preset);
 
 enum class MatchStatus {
@@ -74,10 +83,13 @@ struct MatchResult {
   Pose2D pose;             ///< new scan in the reference frame (final)
   Pose2D prealigned_pose;  ///< after the GA (the guess when there is no GA stage)
   MatchStatus status = MatchStatus::kNoReference;
-  std::uint32_t fitness = 0;   ///< GA fitness of prealigned_pose
-  double fitness_ratio = 0.0;  ///< fitness / (max cell * points), in [0, 1]
-  int evaluations = 0;         ///< GA fitness evaluations
-  int iterations = 0;          ///< MbICP iterations
+  /// The GA's own fitness of prealigned_pose (its lookup table's cells, or PGA's pairing score; 0 without a
+  /// GA stage). How well the final pose fits is the caller's to judge (OdometryTracker: on the fine table).
+  std::uint32_t prealigned_fitness = 0;
+  double prealigned_fitness_ratio =
+      0.0;              ///< prealigned_fitness / its value with every point on the reference
+  int evaluations = 0;  ///< GA fitness evaluations
+  int iterations = 0;   ///< MbICP iterations
   int associations = 0;
   double rms_error = 0.0;  ///< MbICP residual, metres
   MbicpStatus mbicp_status = MbicpStatus::kConverged;

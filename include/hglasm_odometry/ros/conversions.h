@@ -1,10 +1,13 @@
-// Conversions between ROS 1 messages and the ROS-free core types. All functions are NaN/inf-safe:
-// they never throw and never put a non-finite number into an outgoing message.
+// Conversions between ROS 1 messages and the ROS-free core types, the node's outgoing messages and
+// markers included. All functions are NaN/inf-safe: they never throw and never put a non-finite number into
+// an outgoing message.
 #pragma once
 
 #include <Eigen/Core>
 #include <boost/array.hpp>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Pose2D.h>
@@ -12,7 +15,11 @@
 #include <geometry_msgs/Transform.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/LaserScan.h>
+#include <std_msgs/Header.h>
+#include <visualization_msgs/MarkerArray.h>
 
+#include "hglasm_odometry/Match.h"
+#include "hglasm_odometry/core/odometry_pipeline.h"
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
 
@@ -72,5 +79,32 @@ boost::array<double, 36> covariance6x6FromPlanar(const Eigen::Matrix3d& covarian
 
 /// "/laser" -> "laser": tf2 rejects frame ids with a leading slash, old bags (ccny) still carry them.
 std::string stripLeadingSlash(const std::string& frame_id);
+
+/// A float for a message field: 0 for a non-finite value.
+float finiteFloat(double value);
+
+/// Match.msg's constants for the core's enums.
+std::uint8_t toMsg(hglasm::MatchStatus status);
+std::uint8_t toMsg(hglasm::MbicpStatus status);
+std::uint8_t toMsg(hglasm::PredictionSource source);
+
+/// ~odom for a published estimate: the base's pose in `header`'s frame (its stamp too) with its covariance,
+/// and the velocity in the base frame with its covariance (0 if any component is not finite).
+nav_msgs::Odometry odometryMsgFromUpdate(const hglasm::TrackerUpdate& update, const std_msgs::Header& header,
+                                         const std::string& base_frame);
+
+/// ~match for one scan: `scan_header` the scan's (its frame id without a leading slash goes in),
+/// `total_ms` the wall time spent on it, `dropped_scans` the input queue's count so far. Counts below 0
+/// become 0; the poses stay 0 when no match was attempted.
+Match matchMsgFromUpdate(const hglasm::PipelineUpdate& result, const std_msgs::Header& scan_header,
+                         double total_ms, std::uint32_t dropped_scans);
+
+/// ~ga_population: each finite individual of `population` as a heading segment from its position (one
+/// LINE_LIST, id 0, namespace "ga_population"), and arrows for the estimate (green, id 1) and the
+/// prediction the search was centred on (blue, id 2; namespace "ga_estimate"), all in `header`'s frame.
+visualization_msgs::MarkerArray populationMarkers(const std_msgs::Header& header,
+                                                  const std::vector<hglasm::Pose2D>& population,
+                                                  const hglasm::Pose2D& estimate,
+                                                  const hglasm::Pose2D& guess);
 
 }  // namespace hglasm_odometry

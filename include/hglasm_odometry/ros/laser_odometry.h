@@ -78,8 +78,10 @@ class LaserOdometry {
   /// Looks up base -> laser for `laser_frame` (cached); false while tf does not have it yet.
   bool ensureLaserMount(const std::string& laser_frame);
   void processScan(const sensor_msgs::LaserScan& msg);
+  /// ~odom, ~pose, tf and ~path (for a published estimate) and ~match of one scan.
   void publish(const sensor_msgs::LaserScan& msg, const hglasm::PipelineUpdate& update, double total_ms);
-  void publishPopulation(const std_msgs::Header& header, const hglasm::TrackerUpdate& update,
+  void publishPose(const ros::Time& stamp, const hglasm::TrackerUpdate& update);
+  void publishPopulation(const ros::Time& stamp, const hglasm::TrackerUpdate& update,
                          const std::vector<hglasm::Pose2D>& population);
   /// Logs `text` as a warning unless the same `key` was logged less than `period` seconds ago.
   void warnThrottled(const std::string& key, const std::string& text, double period);

@@ -34,12 +34,13 @@ struct DiagnosticsOptions {
 };
 
 struct LaserOdometryOptions {
-  std::string preset = "medium";         ///< name of the preset the matcher options started from
-  hglasm::TrackerOptions tracker;        ///< matcher (from the preset) + keyframes, failure policy, odometry
+  std::string preset = "medium";  ///< name of the preset the matcher options started from
+  /// Matcher (from the preset), keyframes, failure policy, wheel odometry (use_odometry: ~use_odom, also
+  /// whether `odom` is subscribed).
+  hglasm::TrackerOptions tracker;
   std::string odom_frame = "odom";       ///< parent frame of the published pose and tf
   std::string base_frame = "base_link";  ///< frame whose motion is estimated (child frame)
   bool publish_tf = true;                ///< broadcast odom_frame -> base_frame
-  bool use_odom = true;                  ///< subscribe `odom` and use it as the prediction
   int path_length = 1000;                ///< poses kept on ~path; 0 disables ~path
   int queue_size = 5;                    ///< scans waiting to be processed; the oldest is dropped beyond
   bool publish_population = false;       ///< ~ga_population markers (costs a copy of the population)
@@ -59,6 +60,10 @@ bool loadOptions(const XmlRpc::XmlRpcValue& private_params, LaserOdometryOptions
 /// Reads the whole private namespace of `private_nh` and calls the function above.
 bool loadOptions(const ros::NodeHandle& private_nh, LaserOdometryOptions* options, std::string* error,
                  std::vector<std::string>* warnings = nullptr);
+
+/// Every option at the parameter path loadOptions reads it from (~preset and ~presets aside): loading the
+/// result gives `options` back. For comparing a configuration with the shipped YAML, or printing it.
+XmlRpc::XmlRpcValue toParams(const LaserOdometryOptions& options);
 
 /// One line for the log: preset, algorithm, box, GA size, frames.
 std::string summarize(const LaserOdometryOptions& options);

@@ -1,0 +1,96 @@
+// Which scans become keyframes: moved or turned past the thresholds since the newest keyframe (measured
+// between the two base poses, angles wrapped), a failed or poor match, a request, another beam count.
+#include "hglasm_odometry/core/keyframe_policy.h"
+
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+
+namespace {
+
+using hglasm::KeyframePolicy;
+using hglasm::Pose2D;
+using hglasm_test::kPi;
+
+constexpr double kDistance = 0.5;    // m
+constexpr double kAngle = 0.25;      // rad
+constexpr double kMinFitness = 0.6;  // fitness ratio
+
+/// A policy whose newest keyframe was taken with the base at `keyframe` by a 360-beam scanner.
+KeyframePolicy policyAt(const Pose2D& keyframe) {
+  KeyframePolicy policy(kDistance, kAngle, kMinFitness);
+  policy.keyframeAdded(keyframe, 360);
+  return policy;
+}
+
+/// Whether a well matched scan (fitness ratio 1) with the base at `pose` becomes a keyframe.
+bool movedEnough(const KeyframePolicy& policy, const Pose2D& pose) {
+  return policy.wantsKeyframe(pose, true, false, 1.0);
+}
+
+TEST(KeyframePolicy, DistanceFromTheKeyframeInAnyDirection) {
+  const KeyframePolicy policy = policyAt(Pose2D(2.0, -1.0, 0.0));
+  EXPECT_FALSE(movedEnough(policy, Pose2D(2.0, -1.0, 0.0)));
+  EXPECT_FALSE(movedEnough(policy, Pose2D(2.5, -1.0, 0.0)));  // exactly the threshold: not past it
+  EXPECT_TRUE(movedEnough(policy, Pose2D(2.5625, -1.0, 0.0)));
+  EXPECT_FALSE(movedEnough(policy, Pose2D(2.0, -1.4375, 0.0)));
+  EXPECT_TRUE(movedEnough(policy, Pose2D(2.0, -1.5625, 0.0)));
+  // Diagonally: 0.45 m, then 0.54 m.
+  EXPECT_FALSE(movedEnough(policy, Pose2D(1.75, -0.625, 0.0)));
+  EXPECT_TRUE(movedEnough(policy, Pose2D(1.6875, -0.5625, 0.0)));
+}
+
+TEST(KeyframePolicy, HeadingChangeWrapsAroundPi) {
+  const KeyframePolicy policy = policyAt(Pose2D(0.0, 0.0, 3.0));
+  EXPECT_FALSE(movedEnough(policy, Pose2D(0.0, 0.0, 3.125)));
+  EXPECT_TRUE(movedEnough(policy, Pose2D(0.0, 0.0, 2.6875)));
+  // 3.0 to -3.0 rad is a turn of 2 pi - 6 = 0.283 rad, past 0.25; 3.0 to -3.1 is 0.183 rad, not.
+  EXPECT_TRUE(movedEnough(policy, Pose2D(0.0, 0.0, -3.0)));
+  EXPECT_FALSE(movedEnough(policy, Pose2D(0.0, 0.0, -3.1)));
+  EXPECT_FALSE(movedEnough(policy, Pose2D(0.0, 0.0, 2 * kPi - 3.2)));
+}
+
+TEST(KeyframePolicy, FailedOrPoorMatch) {
+  const Pose2D here(1.0, 1.0, 0.5);
+  const KeyframePolicy policy = policyAt(here);
+  EXPECT_FALSE(policy.wantsKeyframe(here, true, false, kMinFitness));
+  EXPECT_TRUE(policy.wantsKeyframe(here, true, false, 0.59));
+  EXPECT_TRUE(policy.wantsKeyframe(here, false, true, 0.0));
+  // Not matched (the prediction was integrated, e.g. a scan too short): its fit says nothing.
+  EXPECT_FALSE(policy.wantsKeyframe(here, false, false, 0.0));
+}
+
+TEST(KeyframePolicy, RequestHoldsUntilAKeyframeIsAddedOrItIsCancelled) {
+  const Pose2D here(1.0, 1.0, 0.5);
+  KeyframePolicy policy = policyAt(here);
+  policy.request();
+  EXPECT_TRUE(movedEnough(policy, here));
+  EXPECT_TRUE(movedEnough(policy, here));  // asking does not consume the request
+  policy.keyframeAdded(here, 360);
+  EXPECT_FALSE(movedEnough(policy, here));
+  policy.request();
+  policy.cancelRequest();
+  EXPECT_FALSE(movedEnough(policy, here));
+}
+
+TEST(KeyframePolicy, KeyframeAddedMovesTheReference) {
+  KeyframePolicy policy = policyAt(Pose2D(0.0, 0.0, 0.0));
+  const Pose2D far(3.0, 0.0, 1.0);
+  EXPECT_TRUE(movedEnough(policy, far));
+  policy.keyframeAdded(far, 360);
+  EXPECT_FALSE(movedEnough(policy, far));
+  EXPECT_TRUE(movedEnough(policy, Pose2D(0.0, 0.0, 0.0)));
+}
+
+TEST(KeyframePolicy, BeamCountOfTheNewestKeyframe) {
+  KeyframePolicy policy = policyAt(Pose2D());
+  EXPECT_EQ(policy.keyframeBeamCount(), 360);
+  EXPECT_FALSE(policy.scannerChanged(360));
+  EXPECT_TRUE(policy.scannerChanged(361));
+  policy.keyframeAdded(Pose2D(), 181);
+  EXPECT_EQ(policy.keyframeBeamCount(), 181);
+  EXPECT_TRUE(policy.scannerChanged(360));
+  EXPECT_FALSE(policy.scannerChanged(181));
+}
+
+}  // namespace

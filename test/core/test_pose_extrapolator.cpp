@@ -1,0 +1,203 @@
+// The prediction of the base's motion between scans (wheel odometry when it covers both stamps and moves
+// plausibly, else the velocity of the recent estimates) and that velocity: its baseline, its frame, its
+// caps and when it is forgotten. Exact answers on synthetic poses.
+#include "hglasm_odometry/core/pose_extrapolator.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "test_util.h"
+
+namespace {
+
+using hglasm::MotionNoiseModel;
+using hglasm::MotionPrediction;
+using hglasm::Pose2D;
+using hglasm::PoseExtrapolator;
+using hglasm::PredictionSource;
+using hglasm_test::kPi;
+
+constexpr double kMaxSpeed = 2.0;     // m/s
+constexpr double kMaxTurnRate = 1.0;  // rad/s
+constexpr double kOdometryAge = 0.5;  // s
+
+PoseExtrapolator makeExtrapolator(bool use_odometry = true) {
+  return PoseExtrapolator(use_odometry, kOdometryAge, kMaxSpeed, kMaxTurnRate);
+}
+
+void expectPose(const Pose2D& actual, double x, double y, double theta, double tolerance = 1e-12) {
+  EXPECT_NEAR(actual.x, x, tolerance);
+  EXPECT_NEAR(actual.y, y, tolerance);
+  EXPECT_NEAR(hglasm_test::angleDiff(actual.theta, theta), 0.0, tolerance);
+}
+
+TEST(PoseExtrapolator, NothingKnownPredictsNoMotionWithConstantVelocityNoise) {
+  const PoseExtrapolator extrapolator = makeExtrapolator();
+  const MotionNoiseModel noise;
+  std::string warning;
+  const MotionPrediction prediction = extrapolator.predict(1.0, 1.5, noise, &warning);
+  EXPECT_EQ(prediction.source, PredictionSource::kNone);
+  expectPose(prediction.motion, 0.0, 0.0, 0.0, 0.0);
+  EXPECT_EQ(prediction.covariance, noise.constantVelocityCovariance(0.5));
+  EXPECT_EQ(prediction.nominal_covariance, Eigen::Matrix3d::Zero());
+  EXPECT_TRUE(warning.empty());
+  EXPECT_FALSE(extrapolator.velocityKnown());
+}
+
+TEST(PoseExtrapolator, OdometryPredictsTheMotionInTheBaseFrame) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  // Facing +y, the base moves 1 m towards -y: backwards in its own frame, and turns 0.5 rad.
+  extrapolator.addOdometry(1.0, Pose2D(1.0, 2.0, kPi / 2));
+  extrapolator.addOdometry(2.0, Pose2D(1.0, 1.0, kPi / 2 + 0.5));
+  const MotionNoiseModel noise;
+  std::string warning;
+  const MotionPrediction prediction = extrapolator.predict(1.0, 2.0, noise, &warning);
+  EXPECT_EQ(prediction.source, PredictionSource::kOdometry);
+  expectPose(prediction.motion, -1.0, 0.0, 0.5);
+  EXPECT_EQ(prediction.covariance, noise.odometryCovariance(prediction.motion, 1.0));
+  EXPECT_EQ(prediction.nominal_covariance, noise.nominalOdometryCovariance(prediction.motion, 1.0));
+  EXPECT_TRUE(warning.empty());
+}
+
+TEST(PoseExtrapolator, OdometryIsInterpolatedToTheStamps) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addOdometry(1.0, Pose2D(1.0, 0.0, 0.0));
+  std::string warning;
+  const MotionPrediction prediction = extrapolator.predict(0.25, 0.75, MotionNoiseModel(), &warning);
+  EXPECT_EQ(prediction.source, PredictionSource::kOdometry);
+  expectPose(prediction.motion, 0.5, 0.0, 0.0, 0.0);
+}
+
+TEST(PoseExtrapolator, WheelJumpFallsBackWithAWarning) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  // 2 m/s over 1 s plus 0.2 m of margin is the most the wheels may move: 2.3 m is a jump, 2.1 m is not.
+  extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addOdometry(1.0, Pose2D(2.1, 0.0, 0.0));
+  extrapolator.addOdometry(2.0, Pose2D(4.4, 0.0, 0.0));
+  const MotionNoiseModel noise;
+  std::string warning;
+  EXPECT_EQ(extrapolator.predict(0.0, 1.0, noise, &warning).source, PredictionSource::kOdometry);
+  EXPECT_TRUE(warning.empty());
+  const MotionPrediction jumped = extrapolator.predict(1.0, 2.0, noise, &warning);
+  EXPECT_EQ(jumped.source, PredictionSource::kNone);
+  expectPose(jumped.motion, 0.0, 0.0, 0.0, 0.0);
+  EXPECT_EQ(jumped.covariance, noise.constantVelocityCovariance(1.0));
+  EXPECT_NE(warning.find("wheel odometry jumped"), std::string::npos) << warning;
+}
+
+TEST(PoseExtrapolator, WheelTurnJumpFallsBack) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  // 1 rad/s over 0.5 s plus 0.2 rad of margin: 0.8 rad is a jump.
+  extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addOdometry(0.5, Pose2D(0.0, 0.0, 0.8));
+  std::string warning;
+  EXPECT_EQ(extrapolator.predict(0.0, 0.5, MotionNoiseModel(), &warning).source, PredictionSource::kNone);
+  EXPECT_FALSE(warning.empty());
+}
+
+TEST(PoseExtrapolator, OdometryIgnoredWhenDisabledStaleOrCleared) {
+  const MotionNoiseModel noise;
+  std::string warning;
+  PoseExtrapolator disabled = makeExtrapolator(false);
+  disabled.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  disabled.addOdometry(1.0, Pose2D(1.0, 0.0, 0.0));
+  EXPECT_EQ(disabled.predict(0.0, 1.0, noise, &warning).source, PredictionSource::kNone);
+
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addOdometry(1.0, Pose2D(1.0, 0.0, 0.0));
+  // The newest sample may be extrapolated 0.5 s, not 0.6 s.
+  EXPECT_EQ(extrapolator.predict(0.0, 1.5, noise, &warning).source, PredictionSource::kOdometry);
+  EXPECT_EQ(extrapolator.predict(0.0, 1.6, noise, &warning).source, PredictionSource::kNone);
+  extrapolator.clearOdometry();
+  EXPECT_EQ(extrapolator.predict(0.0, 1.0, noise, &warning).source, PredictionSource::kNone);
+  EXPECT_TRUE(warning.empty());
+}
+
+TEST(PoseExtrapolator, VelocityNeedsABaselineOfATenthOfASecond) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  // 1.5 m/s along x; stamps and positions exact in binary.
+  EXPECT_EQ(extrapolator.addPose(0.0, Pose2D(0.0, 0.0, 0.0)), 0.0);
+  EXPECT_EQ(extrapolator.addPose(0.0625, Pose2D(0.09375, 0.0, 0.0)), 0.0);
+  EXPECT_FALSE(extrapolator.velocityKnown());
+  // The oldest pose is dropped once the next one alone spans the baseline: 0.25 - 0.0625 >= 0.1.
+  EXPECT_EQ(extrapolator.addPose(0.25, Pose2D(0.375, 0.0, 0.0)), 0.1875);
+  ASSERT_TRUE(extrapolator.velocityKnown());
+  EXPECT_EQ(extrapolator.velocity(), Eigen::Vector3d(1.5, 0.0, 0.0));
+}
+
+TEST(PoseExtrapolator, VelocityIsInTheBaseFrame) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  // Facing +y and moving along +y while turning: forward in its own frame at the start of the baseline.
+  extrapolator.addPose(0.0, Pose2D(3.0, 4.0, kPi / 2));
+  EXPECT_EQ(extrapolator.addPose(0.5, Pose2D(3.0, 4.5, kPi / 2 + 0.25)), 0.5);
+  ASSERT_TRUE(extrapolator.velocityKnown());
+  EXPECT_NEAR(extrapolator.velocity().x(), 1.0, 1e-12);
+  EXPECT_NEAR(extrapolator.velocity().y(), 0.0, 1e-12);
+  EXPECT_NEAR(extrapolator.velocity().z(), 0.5, 1e-12);
+}
+
+TEST(PoseExtrapolator, VelocityIsCappedAtThePlausibleSpeeds) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  // 6 m/s and 8 m/s sideways (10 m/s) become 2 m/s in the same direction; -3 rad/s becomes -1 rad/s.
+  extrapolator.addPose(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addPose(0.5, Pose2D(3.0, 4.0, -1.5));
+  ASSERT_TRUE(extrapolator.velocityKnown());
+  EXPECT_NEAR(extrapolator.velocity().x(), 1.2, 1e-12);
+  EXPECT_NEAR(extrapolator.velocity().y(), 1.6, 1e-12);
+  EXPECT_EQ(extrapolator.velocity().z(), -kMaxTurnRate);
+}
+
+TEST(PoseExtrapolator, VelocityPredictsWithoutOdometry) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  extrapolator.addPose(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addPose(0.5, Pose2D(0.5, -0.25, 0.125));
+  const MotionNoiseModel noise;
+  std::string warning;
+  const MotionPrediction prediction = extrapolator.predict(0.5, 0.75, noise, &warning);
+  EXPECT_EQ(prediction.source, PredictionSource::kConstantVelocity);
+  // (1, -0.5, 0.25) per second, times 0.25 s.
+  expectPose(prediction.motion, 0.25, -0.125, 0.0625, 0.0);
+  EXPECT_EQ(prediction.covariance, noise.constantVelocityCovariance(0.25));
+  EXPECT_EQ(prediction.nominal_covariance, Eigen::Matrix3d::Zero());
+}
+
+TEST(PoseExtrapolator, OldMotionIsForgotten) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  extrapolator.addPose(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addPose(0.5, Pose2D(0.5, 0.0, 0.0));
+  ASSERT_TRUE(extrapolator.velocityKnown());
+  // 2.5 s since the previous estimate: longer than kMaxVelocityAge, the speed now is unknown.
+  EXPECT_EQ(extrapolator.addPose(3.0, Pose2D(0.5, 0.0, 0.0)), 0.0);
+  EXPECT_FALSE(extrapolator.velocityKnown());
+  // The next estimate measures it again over the 0.25 s since.
+  EXPECT_EQ(extrapolator.addPose(3.25, Pose2D(0.75, 0.0, 0.0)), 0.25);
+  EXPECT_TRUE(extrapolator.velocityKnown());
+  EXPECT_EQ(extrapolator.velocity(), Eigen::Vector3d(1.0, 0.0, 0.0));
+}
+
+TEST(PoseExtrapolator, ResetForgetsTheVelocityNotTheOdometry) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addOdometry(1.0, Pose2D(1.0, 0.0, 0.0));
+  extrapolator.addPose(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addPose(0.5, Pose2D(0.5, 0.0, 0.0));
+  ASSERT_TRUE(extrapolator.velocityKnown());
+  extrapolator.reset();
+  EXPECT_FALSE(extrapolator.velocityKnown());
+  EXPECT_EQ(extrapolator.velocity(), Eigen::Vector3d::Zero());
+  std::string warning;
+  EXPECT_EQ(extrapolator.predict(0.0, 1.0, MotionNoiseModel(), &warning).source, PredictionSource::kOdometry);
+  // The poses before the reset are gone: one new estimate gives no baseline.
+  EXPECT_EQ(extrapolator.addPose(0.75, Pose2D(0.0, 0.0, 0.0)), 0.0);
+}
+
+TEST(PoseExtrapolator, SourceNames) {
+  EXPECT_STREQ(hglasm::toString(PredictionSource::kOdometry), "odometry");
+  EXPECT_STREQ(hglasm::toString(PredictionSource::kConstantVelocity), "constant_velocity");
+  EXPECT_STREQ(hglasm::toString(PredictionSource::kNone), "none");
+}
+
+}  // namespace
