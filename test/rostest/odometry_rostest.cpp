@@ -43,11 +43,11 @@
 #include "hglasm_odometry/Match.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
 #include "hglasm_odometry/core/odometry_pipeline.h"
-#include "hglasm_odometry/core/relations.h"
 #include "hglasm_odometry/core/scan_matcher.h"
-#include "hglasm_odometry/ros/bag_reader.h"
+#include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/conversions.h"
 #include "hglasm_odometry/ros/parameters.h"
+#include "hglasm_odometry/tools/bag_reader.h"
 
 namespace hglasm_odometry {
 namespace {
