@@ -250,27 +250,26 @@ class ParamWriter : public OptionVisitor<ParamWriter> {
   XmlRpcValue* root_;
 };
 
-/// Every option except ~preset itself (which selects the starting point), each at its parameter path with
-/// its valid range: read (ParamTree) from the ~presets/<name> subtree and from the top level alike, or
-/// written (ParamWriter). The one list of the parameters.
+// The one list of the parameters, by layer (visitOptions below): each option at its parameter path with
+// its valid range.
+
+/// Frames, topics' behaviour, queue.
 template <typename Params>
-void visitOptions(Params& tree, LaserOdometryOptions* options) {
-  hglasm::TrackerOptions& tracker = options->tracker;
-  hglasm::MatcherOptions& matcher = tracker.matcher;
-
-  tree.algorithm("algorithm", &matcher.algorithm);
-
-  // Frames, topics' behaviour, queue.
+void visitNodeOptions(Params& tree, LaserOdometryOptions* options) {
   tree.frame("odom_frame", &options->odom_frame);
   tree.frame("base_frame", &options->base_frame);
   tree.boolean("publish_tf", &options->publish_tf);
-  tree.boolean("use_odom", &tracker.use_odometry);
+  tree.boolean("use_odom", &options->tracker.use_odometry);
   tree.integer("path_length", &options->path_length, 0, 1000000);
   tree.integer("queue_size", &options->queue_size, 1, 10000);
   tree.boolean("publish_population", &options->publish_population);
   tree.positiveNumber("tf_warn_period", &options->tf_warn_period);
+}
 
-  // Keyframes and failure policy.
+/// Keyframes, failure policy, the search around the prediction and leaps away from it, the local map.
+template <typename Params>
+void visitTrackerOptions(Params& tree, hglasm::TrackerOptions* options) {
+  hglasm::TrackerOptions& tracker = *options;
   tree.positiveNumber("keyframe/distance", &tracker.keyframe_distance);
   tree.number("keyframe/angle", &tracker.keyframe_angle, 0.0, M_PI, true);
   tree.fraction("keyframe/min_fitness", &tracker.keyframe_min_fitness);
@@ -295,8 +294,12 @@ void visitOptions(Params& tree, LaserOdometryOptions* options) {
   tree.positiveInteger("local_map/keyframes", &tracker.local_map.keyframes);
   tree.positiveNumber("local_map/max_distance", &tracker.local_map.max_distance);
   tree.nonNegativeNumber("local_map/resolution", &tracker.local_map.resolution);
+}
 
-  // Wheel odometry as the prediction, and its noise.
+/// Wheel odometry as the prediction, and its noise.
+template <typename Params>
+void visitPredictionOptions(Params& tree, LaserOdometryOptions* options) {
+  hglasm::TrackerOptions& tracker = options->tracker;
   tree.nonNegativeNumber("odometry/max_extrapolation", &tracker.odometry_max_extrapolation);
   hglasm::MotionNoiseOptions& motion = tracker.motion;
   tree.nonNegativeNumber("odometry/noise/xy_per_metre", &motion.xy_per_metre);
@@ -314,15 +317,23 @@ void visitOptions(Params& tree, LaserOdometryOptions* options) {
   tree.positiveNumber("odometry/max_speed", &tracker.max_odometry_speed);
   tree.positiveNumber("odometry/max_turn_rate", &tracker.max_odometry_turn_rate);
   tree.number("odometry/wait", &options->odometry_wait, 0.0, 10.0);
+}
 
-  // Scan conversion.
-  tree.nonNegativeNumber("scan/min_range", &tracker.conversion.min_range);
-  tree.number("scan/max_range", &tracker.conversion.max_range, 0.0, kInf, true, true);
-  tree.integer("scan/beam_step", &tracker.conversion.beam_step, 1, 100);
-  tree.boolean("scan/deskew", &tracker.deskew);
-  tree.number("scan/sweep_time", &tracker.conversion.sweep_time, 0.0, hglasm::kMaxSweepTime);
+/// Scan conversion.
+template <typename Params>
+void visitScanOptions(Params& tree, hglasm::TrackerOptions* tracker) {
+  tree.nonNegativeNumber("scan/min_range", &tracker->conversion.min_range);
+  tree.number("scan/max_range", &tracker->conversion.max_range, 0.0, kInf, true, true);
+  tree.integer("scan/beam_step", &tracker->conversion.beam_step, 1, 100);
+  tree.boolean("scan/deskew", &tracker->deskew);
+  tree.number("scan/sweep_time", &tracker->conversion.sweep_time, 0.0, hglasm::kMaxSweepTime);
+}
 
-  // Lookup tables (the fine one, and the coarse one of the first GA generations).
+/// Lookup tables (the fine one, and the coarse one of the first GA generations) and the genetic
+/// pre-alignment.
+template <typename Params>
+void visitGeneticOptions(Params& tree, hglasm::MatcherOptions* options) {
+  hglasm::MatcherOptions& matcher = *options;
   for (const char* name : {"table", "coarse_table"}) {
     hglasm::LookupTableOptions& table = std::string(name) == "table" ? matcher.table : matcher.coarse_table;
     const std::string prefix = std::string(name) + "/";
@@ -353,9 +364,12 @@ void visitOptions(Params& tree, LaserOdometryOptions* options) {
   int seed = static_cast<int>(genetic.seed);
   tree.integer("genetic/seed", &seed, 0, std::numeric_limits<int>::max());
   genetic.seed = static_cast<std::uint64_t>(seed);
+}
 
-  // MbICP refinement.
-  hglasm::MbicpOptions& mbicp = matcher.mbicp;
+/// MbICP refinement.
+template <typename Params>
+void visitMbicpOptions(Params& tree, hglasm::MbicpOptions* options) {
+  hglasm::MbicpOptions& mbicp = *options;
   tree.positiveNumber("mbicp/metric_l", &mbicp.metric_l);
   tree.number("mbicp/bearing_window", &mbicp.bearing_window, 0.0, M_PI, true);
   tree.positiveNumber("mbicp/max_distance", &mbicp.max_distance);
@@ -376,7 +390,20 @@ void visitOptions(Params& tree, LaserOdometryOptions* options) {
   tree.fraction("mbicp/min_association_ratio", &mbicp.min_association_ratio);
   tree.fraction("mbicp/degenerate_eigenvalue", &mbicp.degenerate_eigenvalue);
   tree.nonNegativeNumber("mbicp/independent_points", &mbicp.independent_points);
+}
 
+/// Every option except ~preset itself (which selects the starting point), each at its parameter path with
+/// its valid range: read (ParamTree) from the ~presets/<name> subtree and from the top level alike, or
+/// written (ParamWriter). The one list of the parameters.
+template <typename Params>
+void visitOptions(Params& tree, LaserOdometryOptions* options) {
+  tree.algorithm("algorithm", &options->tracker.matcher.algorithm);
+  visitNodeOptions(tree, options);
+  visitTrackerOptions(tree, &options->tracker);
+  visitPredictionOptions(tree, options);
+  visitScanOptions(tree, &options->tracker);
+  visitGeneticOptions(tree, &options->tracker.matcher);
+  visitMbicpOptions(tree, &options->tracker.matcher.mbicp);
   // Diagnostics.
   tree.nonNegativeNumber("diagnostics/min_rate", &options->diagnostics.min_rate);
   tree.fraction("diagnostics/warn_failure_ratio", &options->diagnostics.warn_failure_ratio);
