@@ -77,16 +77,8 @@ void LookupTable::stampFootprints(const ReferencePoints& reference, const std::v
   }
 }
 
-void LookupTable::build(const ReferencePoints& reference_set) {
+void LookupTable::collectSamples(const ReferencePoints& reference_set) {
   const std::vector<Eigen::Vector2d>& reference = reference_set.points;
-  tiles_in_use_ = 0;
-  tiles_x_ = tiles_y_ = 0;
-  tile_index_.clear();
-
-  // Global cell coordinates of the usable reference points, and their bounding box.
-  long min_cx = 0, max_cx = -1, min_cy = 0, max_cy = -1;
-  std::vector<std::pair<long, long>> cells;
-  cells.reserve(reference.size());
   // Stamp centres: the points, plus samples along short gaps between consecutive points, spaced so that
   // every point of the segment is within a quarter sigma of a sample.
   samples_.clear();
@@ -106,6 +98,19 @@ void LookupTable::build(const ReferencePoints& reference_set) {
     }
   }
   if (options_.isolated_footprint > 0.0) stampFootprints(reference_set, joins, spacing);
+}
+
+void LookupTable::build(const ReferencePoints& reference_set) {
+  const std::vector<Eigen::Vector2d>& reference = reference_set.points;
+  tiles_in_use_ = 0;
+  tiles_x_ = tiles_y_ = 0;
+  tile_index_.clear();
+
+  // Global cell coordinates of the usable reference points, and their bounding box.
+  long min_cx = 0, max_cx = -1, min_cy = 0, max_cy = -1;
+  std::vector<std::pair<long, long>> cells;
+  cells.reserve(reference.size());
+  collectSamples(reference_set);
   for (const auto& p : samples_) {
     if (std::abs(p.x()) > kMaxCoordinate || std::abs(p.y()) > kMaxCoordinate) continue;
     const long cx = static_cast<long>(std::floor(p.x() * inv_cell_size_));

@@ -130,6 +130,46 @@ void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
   }
 }
 
+void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const {
+  const double d_sq = dapSquared(p, ref_points_[j], l_sq);
+  if (d_sq < candidate->best) {
+    candidate->best = d_sq, candidate->found = true;
+    Association& association = candidate->association;
+    association.target = ref_points_[j];
+    association.normal = ref_normals_[j];
+    association.on_segment = false;
+    const bool isolated = ref_normals_[j].isZero();
+    association.sampling_tangent = isolated ? ref_tangents_[j] : Eigen::Vector2d::Zero();
+    association.sampling_variance = isolated ? ref_sampling_variance_[j] : 0.0;
+  }
+}
+
+void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const {
+  // Closest point of segment j -> j+1 under the metric, with the metric frozen at p (it varies slowly):
+  // minimise (a - t e)^T M (a - t e), M = I - u u^T / (|p|^2 + L^2), u = (p_y, -p_x).
+  const Eigen::Vector2d u(p.y(), -p.x());
+  const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
+  const Eigen::Vector2d& q = ref_points_[j];
+  const Eigen::Vector2d e = ref_points_[j + 1] - q;
+  const Eigen::Vector2d a = p - q;
+  const double ue = u.dot(e), ua = u.dot(a);
+  const double eme = e.squaredNorm() - ue * ue * u_scale;
+  if (!(eme > 0.0)) return;
+  const double t = (e.dot(a) - ue * ua * u_scale) / eme;
+  if (t <= 0.0 || t >= 1.0) return;  // the end points are candidates of their own
+  const Eigen::Vector2d on_segment = q + t * e;
+  const double d_sq = dapSquared(p, on_segment, l_sq);
+  if (d_sq < candidate->best) {
+    candidate->best = d_sq, candidate->found = true;
+    Association& association = candidate->association;
+    association.target = on_segment;
+    association.normal = unitNormal(e);
+    association.on_segment = true;
+    association.sampling_tangent = Eigen::Vector2d::Zero();
+    association.sampling_variance = 0.0;
+  }
+}
+
 void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
                       std::vector<Association>* out) const {
   out->clear();
@@ -138,46 +178,9 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
   const double window = std::min(options_.bearing_window, M_PI);
 
   for (const auto& p : moved) {
-    double best = gate_sq;
-    Association association;
-    bool found = false;
-
-    // Closest point of segment j -> j+1 under the metric, with the metric frozen at p (it varies slowly):
-    // minimise (a - t e)^T M (a - t e), M = I - u u^T / (|p|^2 + L^2), u = (p_y, -p_x).
-    const Eigen::Vector2d u(p.y(), -p.x());
-    const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
-    auto consider_point = [&](int j) {
-      const double d_sq = dapSquared(p, ref_points_[j], l_sq);
-      if (d_sq < best) {
-        best = d_sq, found = true;
-        association.target = ref_points_[j];
-        association.normal = ref_normals_[j];
-        association.on_segment = false;
-        const bool isolated = ref_normals_[j].isZero();
-        association.sampling_tangent = isolated ? ref_tangents_[j] : Eigen::Vector2d::Zero();
-        association.sampling_variance = isolated ? ref_sampling_variance_[j] : 0.0;
-      }
-    };
-    auto consider_segment = [&](int j) {
-      const Eigen::Vector2d& q = ref_points_[j];
-      const Eigen::Vector2d e = ref_points_[j + 1] - q;
-      const Eigen::Vector2d a = p - q;
-      const double ue = u.dot(e), ua = u.dot(a);
-      const double eme = e.squaredNorm() - ue * ue * u_scale;
-      if (!(eme > 0.0)) return;
-      const double t = (e.dot(a) - ue * ua * u_scale) / eme;
-      if (t <= 0.0 || t >= 1.0) return;  // the end points are candidates of their own
-      const Eigen::Vector2d on_segment = q + t * e;
-      const double d_sq = dapSquared(p, on_segment, l_sq);
-      if (d_sq < best) {
-        best = d_sq, found = true;
-        association.target = on_segment;
-        association.normal = unitNormal(e);
-        association.on_segment = true;
-        association.sampling_tangent = Eigen::Vector2d::Zero();
-        association.sampling_variance = 0.0;
-      }
-    };
+    Candidate candidate;
+    candidate.best = gate_sq;
+    double& best = candidate.best;
 
     // Walk outward in bearing from p's own bearing, both ways, within the window (wrapping at +-pi for
     // 360-degree scans). A reference point at bearing offset D is at least |p| sin D away from p, and
@@ -205,9 +208,9 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
       reach = d_min >= range ? window : std::min(window, std::asin(d_min / range));
     };
     auto visit = [&](int j) {
-      consider_point(j);
-      if (ref_has_next_[j]) consider_segment(j);
-      if (j > 0 && ref_has_next_[j - 1]) consider_segment(j - 1);
+      considerPoint(p, j, l_sq, &candidate);
+      if (ref_has_next_[j]) considerSegment(p, j, l_sq, &candidate);
+      if (j > 0 && ref_has_next_[j - 1]) considerSegment(p, j - 1, l_sq, &candidate);
       // The reach from a larger `best` is still a valid (looser) bound: refresh only on a real gain.
       if (best < 0.5 * reach_best) update_reach();
     };
@@ -225,13 +228,35 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
       visit(sorted_index_[k]);
     }
 
-    if (found) {
-      association.point = p;
-      association.distance_sq = std::max(0.0, best);
-      association.weight = 1.0;
-      out->push_back(association);
+    if (candidate.found) {
+      candidate.association.point = p;
+      candidate.association.distance_sq = std::max(0.0, best);
+      candidate.association.weight = 1.0;
+      out->push_back(candidate.association);
     }
   }
+}
+
+bool Mbicp::converged(const Eigen::Vector3d& step, const Pose2D& pose, double error,
+                      Progress* progress) const {
+  const auto within_min_step = [&](const Pose2D& delta) {
+    return std::abs(delta.x) < options_.min_step_xy && std::abs(delta.y) < options_.min_step_xy &&
+           std::abs(delta.theta) < options_.min_step_theta;
+  };
+  const bool small_step = within_min_step(Pose2D(step.x(), step.y(), step.z()));
+  const bool no_progress =
+      progress->previous_error >= 0.0 &&
+      std::abs(progress->previous_error - error) <= options_.error_ratio * std::max(error, 1e-12);
+  // Back where it was two iterations ago: the associations flip between two sets (a point at the gate's
+  // edge, or between an end point's line and a neighbouring segment) and neither step makes progress.
+  const bool cycling =
+      progress->settled_poses >= 2 && within_min_step(pose * progress->two_poses_ago.inverse());
+  progress->two_poses_ago = progress->previous_pose;
+  progress->previous_pose = pose;
+  ++progress->settled_poses;
+  progress->quiet_iterations = (small_step || no_progress || cycling) ? progress->quiet_iterations + 1 : 0;
+  progress->previous_error = error;
+  return progress->quiet_iterations >= options_.converged_iterations;
 }
 
 MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial, const PosePrior* prior) {
@@ -252,13 +277,10 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial, const PosePrio
     return result;
   }
 
-  double previous_error = -1.0;
-  int quiet_iterations = 0;
+  Progress progress;
   const double fine_gate =
       options_.fine_max_distance > 0.0 ? options_.fine_max_distance : options_.max_distance;
   bool settled = fine_gate == options_.max_distance;
-  Pose2D previous_pose, two_poses_ago;  // estimates of the last two settled iterations
-  int settled_poses = 0;
   result.status = MbicpStatus::kMaxIterations;
   moved_.resize(points.size());
 
@@ -296,25 +318,10 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial, const PosePrio
       settled = std::abs(step.x()) < options_.settle_step_xy &&
                 std::abs(step.y()) < options_.settle_step_xy &&
                 std::abs(step.z()) < options_.settle_step_theta;
-      previous_error = -1.0;
+      progress.previous_error = -1.0;
       continue;
     }
-    const auto within_min_step = [&](const Pose2D& delta) {
-      return std::abs(delta.x) < options_.min_step_xy && std::abs(delta.y) < options_.min_step_xy &&
-             std::abs(delta.theta) < options_.min_step_theta;
-    };
-    const bool small_step = within_min_step(Pose2D(step.x(), step.y(), step.z()));
-    const bool no_progress = previous_error >= 0.0 && std::abs(previous_error - error) <=
-                                                          options_.error_ratio * std::max(error, 1e-12);
-    // Back where it was two iterations ago: the associations flip between two sets (a point at the gate's
-    // edge, or between an end point's line and a neighbouring segment) and neither step makes progress.
-    const bool cycling = settled_poses >= 2 && within_min_step(result.pose * two_poses_ago.inverse());
-    two_poses_ago = previous_pose;
-    previous_pose = result.pose;
-    ++settled_poses;
-    quiet_iterations = (small_step || no_progress || cycling) ? quiet_iterations + 1 : 0;
-    previous_error = error;
-    if (quiet_iterations >= options_.converged_iterations) {
+    if (converged(step, result.pose, error, &progress)) {
       result.status = MbicpStatus::kConverged;
       break;
     }
@@ -344,6 +351,37 @@ double Mbicp::robustScaleSq() const {
   return options_.robust_scale * options_.robust_scale * std::max({*median, noise_sq, kNoiseFloor});
 }
 
+Eigen::Matrix2d Mbicp::associationMetric(const Association& assoc, bool settled, double l_sq,
+                                         double* residual_sq) const {
+  const Eigen::Vector2d& p = assoc.point;
+  const Eigen::Vector2d& c = assoc.target;
+  const Eigen::Vector2d u(c.y(), -c.x());
+  Eigen::Matrix2d m = Eigen::Matrix2d::Identity() - u * u.transpose() / (c.squaredNorm() + l_sq);
+  // A point just past a segment's end point: point-to-point while the estimate moves (its pull along
+  // the surface helps turn a scan in from afar), then onto that end point's line (point-to-point would
+  // pull it towards the last reference beam: a rotation bias at every edge).
+  const bool line_residual =
+      options_.point_to_line && (assoc.on_segment || (settled && !assoc.normal.isZero()));
+  *residual_sq = assoc.distance_sq;
+  if (line_residual) {
+    // Distance to the line under the metric: remove the metric-weighted tangent direction.
+    const Eigen::Vector2d tangent(assoc.normal.y(), -assoc.normal.x());
+    const Eigen::Vector2d m_tangent = m * tangent;
+    m -= m_tangent * m_tangent.transpose() / tangent.dot(m_tangent);
+    const double r = assoc.normal.dot(p - c);
+    *residual_sq = r * r;
+  } else if (options_.point_noise > 0.0 && assoc.sampling_variance > 0.0) {
+    // Isolated reference point: across its beam the residual is mostly the sampling's, not the pose's.
+    const double noise_sq = options_.point_noise * options_.point_noise;
+    const double keep = noise_sq / (noise_sq + assoc.sampling_variance);
+    const Eigen::Vector2d m_tangent = m * assoc.sampling_tangent;
+    m -= (1.0 - keep) * m_tangent * m_tangent.transpose() / assoc.sampling_tangent.dot(m_tangent);
+    const Eigen::Vector2d d = p - c;
+    *residual_sq = d.dot(m * d);
+  }
+  return m;
+}
+
 bool Mbicp::solveStep(const Pose2D& pose, bool settled, std::size_t min_associations, const PosePrior* prior,
                       Eigen::Vector3d* step, Eigen::Vector3d* scan_only_step, double* error) {
   // Trimming: the worst associations (moved objects, unmatched structure) do not vote; robust weights make
@@ -366,30 +404,8 @@ bool Mbicp::solveStep(const Pose2D& pose, bool settled, std::size_t min_associat
   for (auto& assoc : associations_) {
     const Eigen::Vector2d& p = assoc.point;
     const Eigen::Vector2d& c = assoc.target;
-    const Eigen::Vector2d u(c.y(), -c.x());
-    Eigen::Matrix2d m = Eigen::Matrix2d::Identity() - u * u.transpose() / (c.squaredNorm() + l_sq);
-    // A point just past a segment's end point: point-to-point while the estimate moves (its pull along
-    // the surface helps turn a scan in from afar), then onto that end point's line (point-to-point would
-    // pull it towards the last reference beam: a rotation bias at every edge).
-    const bool line_residual =
-        options_.point_to_line && (assoc.on_segment || (settled && !assoc.normal.isZero()));
-    double residual_sq_one = assoc.distance_sq;
-    if (line_residual) {
-      // Distance to the line under the metric: remove the metric-weighted tangent direction.
-      const Eigen::Vector2d tangent(assoc.normal.y(), -assoc.normal.x());
-      const Eigen::Vector2d m_tangent = m * tangent;
-      m -= m_tangent * m_tangent.transpose() / tangent.dot(m_tangent);
-      const double r = assoc.normal.dot(p - c);
-      residual_sq_one = r * r;
-    } else if (options_.point_noise > 0.0 && assoc.sampling_variance > 0.0) {
-      // Isolated reference point: across its beam the residual is mostly the sampling's, not the pose's.
-      const double noise_sq = options_.point_noise * options_.point_noise;
-      const double keep = noise_sq / (noise_sq + assoc.sampling_variance);
-      const Eigen::Vector2d m_tangent = m * assoc.sampling_tangent;
-      m -= (1.0 - keep) * m_tangent * m_tangent.transpose() / assoc.sampling_tangent.dot(m_tangent);
-      const Eigen::Vector2d d = p - c;
-      residual_sq_one = d.dot(m * d);
-    }
+    double residual_sq_one = 0.0;
+    Eigen::Matrix2d m = associationMetric(assoc, settled, l_sq, &residual_sq_one);
     assoc.weight = robust_scale_sq > 0.0 ? 1.0 / (1.0 + assoc.distance_sq / robust_scale_sq) : 1.0;
     m *= assoc.weight;
     residual_sq += assoc.weight * residual_sq_one;

@@ -107,7 +107,9 @@ MatcherOptions presetOptions(Preset preset) {
       // finds the true basin instead of a 180-degree look-alike more often (intel, whole box, 5 seeds of
       // 500 trials: 97.1 -> 98.6 %).
       options.genetic.coarse_generations = 6;
-      options.coarse_table = LookupTableOptions{TableKind::kGraded, 0.12, 0.60, 1.20, 0.30, 0.10};
+      options.coarse_table.cell_size = 0.12;
+      options.coarse_table.sigma = 0.60;
+      options.coarse_table.cutoff = 1.20;
       break;
   }
   // PGA pairs within the reach of GLASM's tables: the fine table's cut-off, then the coarse one's.

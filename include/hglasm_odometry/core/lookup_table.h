@@ -93,6 +93,8 @@ class LookupTable {
     return std::abs(p.x()) <= kMaxCoordinate && std::abs(p.y()) <= kMaxCoordinate;  // false for NaN
   }
   void buildKernel();
+  /// Stamp centres (samples_): the points, samples along joined gaps and isolated points' footprints.
+  void collectSamples(const ReferencePoints& reference);
   /// Adds samples across the beam of each isolated reference point (isolated_footprint).
   void stampFootprints(const ReferencePoints& reference, const std::vector<std::uint8_t>& joins,
                        double spacing);

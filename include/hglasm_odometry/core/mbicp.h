@@ -120,11 +120,32 @@ class Mbicp {
   /// Per kept reference point: the direction across its beam and the variance of its sampling along it.
   void computeSamplingUncertainty(const ReferencePoints& reference,
                                   const std::vector<std::size_t>& scan_of_point);
+  /// Convergence bookkeeping of the settled iterations.
+  struct Progress {
+    double previous_error = -1.0;
+    int quiet_iterations = 0;
+    Pose2D previous_pose, two_poses_ago;  // estimates of the last two settled iterations
+    int settled_poses = 0;
+  };
+  /// After a settled iteration: true once converged_iterations in a row made no progress.
+  bool converged(const Eigen::Vector3d& step, const Pose2D& pose, double error, Progress* progress) const;
+  /// The best association of one point so far (d_ap^2 below `best`).
+  struct Candidate {
+    double best = 0.0;
+    bool found = false;
+    Association association;
+  };
+  void considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const;
+  void considerSegment(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const;
   void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) const;
-  /// Weighs the associations (robust_scale) and solves for the increment (pose = increment * pose); false if
-  /// the system has no finite solution. c^2 of the robust weights for the current associations (0: no
-  /// weights).
+  /// c^2 of the robust weights for the current associations (0: no weights).
   double robustScaleSq() const;
+  /// The d_ap metric of one association (to its segment's line, or weighed against an isolated reference
+  /// point's sampling), and its squared residual under it.
+  Eigen::Matrix2d associationMetric(const Association& assoc, bool settled, double l_sq,
+                                    double* residual_sq) const;
+  /// Trims and weighs the associations (trim_fraction, robust_scale) and solves for the increment
+  /// (pose = increment * pose); false if the system has no finite solution.
   bool solveStep(const Pose2D& pose, bool settled, std::size_t min_associations, const PosePrior* prior,
                  Eigen::Vector3d* step, Eigen::Vector3d* scan_only_step, double* error);
   /// Covariance, calibrated scan information and degeneracy at the final pose from the final associations.
