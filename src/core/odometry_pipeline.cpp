@@ -102,4 +102,10 @@ void OdometryPipeline::reset() {
   keyframe_pose_ = Pose2D();
 }
 
+bool OdometryPipeline::setPose(double stamp, const Pose2D& pose, const Eigen::Matrix3d& covariance) {
+  if (!tracker_.setPose(stamp, pose, covariance)) return false;
+  keyframe_pose_ = tracker_.pose();
+  return true;
+}
+
 }  // namespace hglasm

@@ -76,6 +76,15 @@ bool matchUsable(const MatchResult& match) {
 
 }  // namespace
 
+bool isValidPoseCovariance(const Eigen::Matrix3d& covariance) {
+  if (!covariance.allFinite()) return false;
+  const double scale = 1.0 + covariance.cwiseAbs().maxCoeff();
+  if ((covariance - covariance.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale) return false;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(0.5 * (covariance + covariance.transpose()),
+                                                              Eigen::EigenvaluesOnly);
+  return solver.eigenvalues().minCoeff() >= -1e-12 * scale;
+}
+
 void OdometryTracker::RunningStats::add(double value) {
   // Exponentially weighted mean and variance: the usual fit drifts with the scene.
   const double alpha =
@@ -133,6 +142,29 @@ void OdometryTracker::reset() {
   prediction_wrong_ = 0.0;
   fitness_ = RunningStats();
   have_scan_only_pose_ = false;
+  set_pose_stamp_.reset();
+}
+
+bool OdometryTracker::setPose(double stamp, const Pose2D& pose, const Eigen::Matrix3d& covariance) {
+  if (!std::isfinite(stamp) || !pose.isFinite() || !isValidPoseCovariance(covariance)) return false;
+  reset();
+  pose_ = Pose2D(pose.x, pose.y, normalizeAngle(pose.theta));
+  pose_covariance_ = symmetricClamped(covariance);
+  set_pose_stamp_ = stamp;
+  return true;
+}
+
+void OdometryTracker::advanceSetPose(double stamp, TrackerUpdate* update) {
+  const double from = *set_pose_stamp_;
+  set_pose_stamp_.reset();
+  if (!(stamp > from)) return;  // a scan at or before the pose's stamp starts from the pose as given
+  std::string warning;
+  const MotionPrediction motion = extrapolator_.predict(from, stamp, noise_, &warning);
+  if (motion.source != PredictionSource::kOdometry) return;  // no wheel motion known: the pose as given
+  pose_covariance_ = composeClamped(pose_, pose_covariance_, motion.motion, motion.covariance);
+  pose_ = pose_ * motion.motion;
+  update->guess = pose_;
+  update->prediction = motion.source;
 }
 
 Pose2D OdometryTracker::toMap(const Pose2D& base_pose) const {
@@ -422,6 +454,7 @@ bool OdometryTracker::handleTime(double stamp, TrackerUpdate* update) {
 void OdometryTracker::initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update) {
   initialised_ = true;
   last_stamp_ = stamp;
+  if (set_pose_stamp_) advanceSetPose(stamp, update);
   extrapolator_.addPose(stamp, pose_);
   update->reset = true;
   update->published = true;

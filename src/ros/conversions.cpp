@@ -178,6 +178,41 @@ bool pose2DFromOdometryMsg(const nav_msgs::Odometry& msg, hglasm::Pose2D* pose) 
   return pose2DFromPoseMsg(msg.pose.pose, pose);
 }
 
+bool poseRequestFromMsg(const geometry_msgs::PoseWithCovarianceStamped& msg, const std::string& odom_frame,
+                        PoseRequest* request, std::string* error) {
+  const std::string frame = stripLeadingSlash(msg.header.frame_id);
+  if (frame != odom_frame) {
+    *error = "the pose is in frame \"" + frame + "\", not in odom_frame \"" + odom_frame + "\"";
+    return false;
+  }
+  const geometry_msgs::Pose& pose = msg.pose.pose;
+  const auto& q = pose.orientation;
+  if (!std::isfinite(pose.position.x) || !std::isfinite(pose.position.y) || !std::isfinite(pose.position.z)) {
+    *error = "the position is not finite";
+    return false;
+  }
+  if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z) || !std::isfinite(q.w)) {
+    *error = "the orientation is not finite";
+    return false;
+  }
+  const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+  if (!(norm >= 1e-6) || !std::isfinite(norm)) {
+    *error = "the orientation quaternion cannot be normalised (length " + std::to_string(norm) + ")";
+    return false;
+  }
+  request->stamp = msg.header.stamp.toSec();
+  request->pose = hglasm::Pose2D(pose.position.x, pose.position.y, yawFromQuaternion(q));
+  // Planar index (x, y, theta) <- 6D index (x, y, yaw).
+  constexpr int kIndex[3] = {0, 1, 5};
+  Eigen::Matrix3d covariance;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) covariance(r, c) = msg.pose.covariance[6 * kIndex[r] + kIndex[c]];
+  }
+  request->covariance_replaced = !hglasm::isValidPoseCovariance(covariance);
+  request->covariance = request->covariance_replaced ? Eigen::Matrix3d::Zero() : covariance;
+  return true;
+}
+
 boost::array<double, 36> covariance6x6FromPlanar(const Eigen::Matrix3d& covariance,
                                                  double unobserved_variance) {
   if (!std::isfinite(unobserved_variance) || unobserved_variance <= 0.0)

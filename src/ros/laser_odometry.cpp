@@ -54,6 +54,7 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
     population_pub_ = private_nh_.advertise<visualization_msgs::MarkerArray>("ga_population", 2);
   }
   reset_service_ = private_nh_.advertiseService("reset", &LaserOdometry::resetCallback, this);
+  set_pose_service_ = private_nh_.advertiseService("set_pose", &LaserOdometry::setPoseCallback, this);
 
   diagnostics_.setHardwareID("none");
   diagnostics_.add("laser odometry", this, &LaserOdometry::diagnose);
@@ -69,6 +70,11 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
     odom_sub_ = nh_.subscribe("odom", kOdomSubscriberQueue, &LaserOdometry::odomCallback, this,
                               ros::TransportHints().tcpNoDelay());
   }
+  if (options_.set_pose.topic_enabled) {
+    set_pose_sub_ =
+        private_nh_.subscribe(options_.set_pose.topic, 5, &LaserOdometry::setPoseTopicCallback, this);
+    ROS_INFO_STREAM("[" << name_ << "] taking poses to continue from on " << set_pose_sub_.getTopic());
+  }
   ROS_INFO_STREAM("[" << name_ << "] laser odometry on " << scan_sub_.getTopic()
                       << (options_.tracker.use_odometry ? " + " + odom_sub_.getTopic()
                                                         : std::string(" (no wheel odometry)"))
@@ -78,7 +84,9 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
 LaserOdometry::~LaserOdometry() {
   scan_sub_.shutdown();
   odom_sub_.shutdown();
+  set_pose_sub_.shutdown();
   reset_service_.shutdown();
+  set_pose_service_.shutdown();
   diagnostics_timer_.stop();
   {
     std::lock_guard<std::mutex> lock(input_mutex_);
@@ -124,16 +132,66 @@ bool LaserOdometry::resetCallback(std_srvs::Empty::Request&, std_srvs::Empty::Re
   {
     std::lock_guard<std::mutex> lock(input_mutex_);
     reset_requested_ = true;
+    pose_requested_.reset();
   }
   input_cv_.notify_all();
   ROS_INFO_STREAM("[" << name_ << "] reset requested: restarting from the origin at the next scan");
   return true;
 }
 
+bool LaserOdometry::requestPose(const geometry_msgs::PoseWithCovarianceStamped& msg, std::string* message) {
+  PoseRequest request;
+  std::string error;
+  if (!poseRequestFromMsg(msg, options_.odom_frame, &request, &error)) {
+    *message = "pose refused: " + error;
+    return false;
+  }
+  if (request.stamp == 0.0) request.stamp = ros::Time::now().toSec();
+  std::ostringstream text;
+  text << "continuing from x " << request.pose.x << " m, y " << request.pose.y << " m, yaw "
+       << request.pose.theta << " rad in " << options_.odom_frame << " at the next scan";
+  if (request.covariance_replaced) {
+    text << " (its covariance is not a valid x, y, yaw covariance: zero used, the pose taken as exact)";
+  }
+  *message = text.str();
+  {
+    std::lock_guard<std::mutex> lock(input_mutex_);
+    pose_requested_ = request;
+    reset_requested_ = false;
+  }
+  input_cv_.notify_all();
+  return true;
+}
+
+bool LaserOdometry::setPoseCallback(SetPose::Request& request, SetPose::Response& response) {
+  response.success = requestPose(request.pose, &response.message);
+  if (response.success) {
+    ROS_INFO_STREAM("[" << name_ << "] ~set_pose: " << response.message);
+  } else {
+    ROS_WARN_STREAM("[" << name_ << "] ~set_pose: " << response.message);
+  }
+  return true;  // a refused pose is an answer, not a failed call
+}
+
+void LaserOdometry::setPoseTopicCallback(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
+  std::string message;
+  if (requestPose(*msg, &message)) {
+    ROS_INFO_STREAM("[" << name_ << "] " << set_pose_sub_.getTopic() << ": " << message);
+  } else {
+    ROS_WARN_STREAM("[" << name_ << "] " << set_pose_sub_.getTopic() << ": " << message);
+  }
+}
+
 void LaserOdometry::takeQueuedInputs() {
   if (reset_requested_) {
     pipeline_.reset();
     reset_requested_ = false;
+  }
+  if (pose_requested_) {
+    if (!pipeline_.setPose(pose_requested_->stamp, pose_requested_->pose, pose_requested_->covariance)) {
+      ROS_WARN_STREAM("[" << name_ << "] the pose to continue from was refused by the tracker");
+    }
+    pose_requested_.reset();
   }
   for (const OdometrySample& sample : odometry_) {
     if (!sample.child_frame.empty() && sample.child_frame != options_.base_frame &&

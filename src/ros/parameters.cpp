@@ -5,6 +5,8 @@
 #include <set>
 #include <sstream>
 
+#include <ros/names.h>
+
 #include "hglasm_odometry/core/scan_matcher.h"
 #include "hglasm_odometry/ros/conversions.h"
 
@@ -187,6 +189,18 @@ class ParamTree : public OptionVisitor<ParamTree> {
     if (string(path, &frame)) *out = stripLeadingSlash(frame);
   }
 
+  /// A valid relative or absolute graph resource name (not a private "~" one).
+  void topic(const std::string& path, std::string* out) {
+    std::string name;
+    if (!string(path, &name)) return;
+    std::string why;
+    if (name[0] == '~' || !ros::names::validate(name, why)) {
+      fail(path, "a relative or absolute topic name", describe(name));
+      return;
+    }
+    *out = name;
+  }
+
   void algorithm(const std::string& path, hglasm::Algorithm* out) {
     std::string name;
     if (string(path, &name) && !hglasm::parseAlgorithm(name, out)) {
@@ -233,6 +247,7 @@ class ParamWriter : public OptionVisitor<ParamWriter> {
   void integer(const std::string& path, int* value, int, int) { set(path, XmlRpcValue(*value)); }
   void boolean(const std::string& path, bool* value) { set(path, XmlRpcValue(*value)); }
   void frame(const std::string& path, std::string* value) { set(path, XmlRpcValue(*value)); }
+  void topic(const std::string& path, std::string* value) { set(path, XmlRpcValue(*value)); }
   void algorithm(const std::string& path, hglasm::Algorithm* value) {
     set(path, XmlRpcValue(std::string(hglasm::toString(*value))));
   }
@@ -264,6 +279,8 @@ void visitNodeOptions(Params& tree, LaserOdometryOptions* options) {
   tree.integer("queue_size", &options->queue_size, 1, 10000);
   tree.boolean("publish_population", &options->publish_population);
   tree.positiveNumber("tf_warn_period", &options->tf_warn_period);
+  tree.boolean("set_pose/topic_enabled", &options->set_pose.topic_enabled);
+  tree.topic("set_pose/topic", &options->set_pose.topic);
 }
 
 /// Keyframes, failure policy, the search around the prediction and leaps away from it, the local map.

@@ -196,4 +196,34 @@ TEST(OdometryPipeline, ResetRestartsAtTheOriginAndKeepsTheMount) {
                               0.01, 0.005, "match after reset");
 }
 
+TEST(OdometryPipeline, SetPoseRestartsFromThePoseAndKeepsTheMount) {
+  TrackerOptions options;
+  options.use_odometry = false;
+  OdometryPipeline pipeline(options);
+  const Pose2D mount(0.3, 0.1, 0.4);
+  pipeline.setLaserMount(mount, false);
+  for (int i = 0; i <= 5; ++i) {
+    const double t = 0.1 * i;
+    pipeline.processScan(t, rangesAt(hglasm_test::composeByHand(straightAt(t), mount), false));
+  }
+  const Pose2D set(5.0, -2.0, 1.0);
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity() * 0.01;
+  EXPECT_FALSE(pipeline.setPose(0.6, set, -covariance));
+  ASSERT_TRUE(pipeline.setPose(0.6, set, covariance));
+  hglasm_test::expectPoseNear(pipeline.pose(), set, 1e-12, 1e-12, "pipeline.pose()");
+  const PipelineUpdate first =
+      pipeline.processScan(0.6, rangesAt(hglasm_test::composeByHand(straightAt(0.6), mount), false));
+  EXPECT_TRUE(first.tracker.reset);
+  hglasm_test::expectPoseNear(first.tracker.pose, set, 1e-12, 1e-12, "first.tracker.pose");
+  EXPECT_TRUE(first.tracker.pose_covariance.isApprox(covariance, 1e-12));
+  const PipelineUpdate second =
+      pipeline.processScan(0.7, rangesAt(hglasm_test::composeByHand(straightAt(0.7), mount), false));
+  ASSERT_TRUE(second.laser_guess.has_value());
+  hglasm_test::expectPoseNear(second.tracker.pose, set * Pose2D(0.05, 0.0, 0.0), 0.01, 0.005, "after set");
+  // The guess is relative to the new keyframe at the set pose: the identity (no motion known yet).
+  hglasm_test::expectPoseNear(*second.laser_guess, Pose2D(), 1e-9, 1e-9, "guess after set");
+  hglasm_test::expectPoseNear(second.tracker.match.pose, mount.inverse() * Pose2D(0.05, 0.0, 0.0) * mount,
+                              0.01, 0.005, "match after set");
+}
+
 }  // namespace

@@ -457,4 +457,111 @@ TEST(OdometryTracker, ExplicitResetRestartsAtTheOrigin) {
   EXPECT_EQ(robot.tracker().pose().x, 0.0);
 }
 
+Eigen::Matrix3d someCovariance() {
+  Eigen::Matrix3d covariance;
+  covariance << 0.04, 0.01, 0.0, 0.01, 0.09, 0.002, 0.0, 0.002, 0.01;
+  return covariance;
+}
+
+TEST(OdometryTracker, SetPoseContinuesFromTheGivenPoseWithTheWheelMotionSince) {
+  SimulatedRobot robot(TrackerOptions(), straightPath(0.4));
+  robot.enableOdometry(0.0, 0.0);
+  for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
+  const Pose2D set(2.0, -1.0, 0.5);
+  ASSERT_TRUE(robot.tracker().setPose(0.5, set, someCovariance()));
+  hglasm_test::expectPoseNear(robot.tracker().pose(), set, 1e-12, 1e-12, "robot.tracker().pose()");
+  // The next scan, 0.1 s later: the set pose moved on by the wheels' 4 cm, its covariance grown by theirs.
+  const TrackerUpdate first = robot.step(0.6);
+  expectSane(first);
+  EXPECT_TRUE(first.reset);
+  EXPECT_FALSE(first.matched);
+  EXPECT_TRUE(first.new_keyframe);
+  hglasm_test::expectPoseNear(first.pose, set * Pose2D(0.04, 0.0, 0.0), 1e-9, 1e-9, "first after setPose");
+  EXPECT_GT(first.pose_covariance(0, 0), someCovariance()(0, 0));
+  EXPECT_NEAR(first.pose_covariance(0, 0), someCovariance()(0, 0), 0.01);
+  // Later scans: the set pose composed with the motion since (the matches against the new keyframe).
+  TrackerUpdate update;
+  for (int i = 7; i <= 20; ++i) {
+    update = robot.step(0.1 * i);
+    expectSane(update);
+    EXPECT_FALSE(update.reset);
+  }
+  EXPECT_TRUE(update.matched);
+  hglasm_test::expectPoseNear(update.pose, set * Pose2D(0.4 * 1.5, 0.0, 0.0), 0.02, 0.01, "after 1.5 s");
+}
+
+TEST(OdometryTracker, SetPoseAtTheScanStampKeepsTheGivenCovariance) {
+  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
+  const Pose2D set(-3.0, 4.0, -2.0);
+  ASSERT_TRUE(robot.tracker().setPose(0.6, set, someCovariance()));
+  const TrackerUpdate first = robot.step(0.6);
+  EXPECT_TRUE(first.reset);
+  hglasm_test::expectPoseNear(first.pose, set, 1e-12, 1e-12, "first.pose");
+  EXPECT_TRUE(first.pose_covariance.isApprox(someCovariance(), 1e-12)) << first.pose_covariance;
+  const TrackerUpdate second = robot.step(0.7);
+  EXPECT_TRUE(second.matched);
+  hglasm_test::expectPoseNear(second.pose, set * Pose2D(0.04, 0.0, 0.0), 0.01, 0.005, "second");
+  EXPECT_GE(second.pose_covariance(0, 0), someCovariance()(0, 0));
+}
+
+TEST(OdometryTracker, ResetAndSetPoseInterleavedTheLastOneWins) {
+  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  for (int i = 0; i <= 3; ++i) robot.step(0.1 * i);
+  const Pose2D set(1.0, 2.0, 0.3);
+  ASSERT_TRUE(robot.tracker().setPose(0.3, set, someCovariance()));
+  robot.tracker().reset();
+  TrackerUpdate update = robot.step(0.4);
+  EXPECT_TRUE(update.reset);
+  hglasm_test::expectPoseNear(update.pose, Pose2D(), 1e-12, 1e-12, "update.pose");
+  EXPECT_EQ(update.pose_covariance, Eigen::Matrix3d::Zero());
+
+  robot.tracker().reset();
+  ASSERT_TRUE(robot.tracker().setPose(0.5, set, someCovariance()));
+  update = robot.step(0.5);
+  EXPECT_TRUE(update.reset);
+  hglasm_test::expectPoseNear(update.pose, set, 1e-12, 1e-12, "update.pose");
+
+  const Pose2D other(-1.0, 0.5, -0.1);
+  ASSERT_TRUE(robot.tracker().setPose(0.6, set, someCovariance()));
+  ASSERT_TRUE(robot.tracker().setPose(0.6, other, Eigen::Matrix3d::Zero()));
+  update = robot.step(0.6);
+  EXPECT_TRUE(update.reset);
+  hglasm_test::expectPoseNear(update.pose, other, 1e-12, 1e-12, "update.pose");
+  EXPECT_EQ(update.pose_covariance, Eigen::Matrix3d::Zero());
+  update = robot.step(0.7);
+  EXPECT_FALSE(update.reset);
+  hglasm_test::expectPoseNear(update.pose, other * Pose2D(0.04, 0.0, 0.0), 0.01, 0.005, "after two");
+}
+
+TEST(OdometryTracker, SetPoseRejectsInvalidInputAndChangesNothing) {
+  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  Eigen::Matrix3d asymmetric = someCovariance();
+  asymmetric(0, 1) += 0.01;
+  Eigen::Matrix3d indefinite = someCovariance();
+  indefinite(2, 2) = -0.01;
+  Eigen::Matrix3d not_finite = someCovariance();
+  not_finite(1, 1) = inf;
+  OdometryTracker& tracker = robot.tracker();
+  const Pose2D before = tracker.pose();
+  EXPECT_FALSE(tracker.setPose(nan, Pose2D(1.0, 1.0, 0.0), someCovariance()));
+  EXPECT_FALSE(tracker.setPose(0.5, hglasm_test::rawPose(nan, 1.0, 0.0), someCovariance()));
+  EXPECT_FALSE(tracker.setPose(0.5, hglasm_test::rawPose(1.0, inf, 0.0), someCovariance()));
+  EXPECT_FALSE(tracker.setPose(0.5, hglasm_test::rawPose(1.0, 1.0, nan), someCovariance()));
+  EXPECT_FALSE(tracker.setPose(0.5, Pose2D(1.0, 1.0, 0.0), asymmetric));
+  EXPECT_FALSE(tracker.setPose(0.5, Pose2D(1.0, 1.0, 0.0), indefinite));
+  EXPECT_FALSE(tracker.setPose(0.5, Pose2D(1.0, 1.0, 0.0), not_finite));
+  hglasm_test::expectPoseNear(tracker.pose(), before, 1e-12, 1e-12, "tracker.pose()");
+  const TrackerUpdate update = robot.step(0.6);
+  EXPECT_FALSE(update.reset);
+  EXPECT_TRUE(update.matched);
+  hglasm_test::expectPoseNear(update.pose, Pose2D(0.24, 0.0, 0.0), 0.01, 0.005, "tracking went on");
+  EXPECT_TRUE(hglasm::isValidPoseCovariance(someCovariance()));
+  EXPECT_TRUE(hglasm::isValidPoseCovariance(Eigen::Matrix3d::Zero()));
+  EXPECT_FALSE(hglasm::isValidPoseCovariance(indefinite));
+}
+
 }  // namespace

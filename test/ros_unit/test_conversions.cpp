@@ -314,5 +314,76 @@ TEST(FrameIds, LeadingSlashesAreStripped) {
   EXPECT_EQ(stripLeadingSlash(""), "");
 }
 
+geometry_msgs::PoseWithCovarianceStamped setPoseMsg(const std::string& frame) {
+  geometry_msgs::PoseWithCovarianceStamped msg;
+  msg.header.frame_id = frame;
+  msg.header.stamp = ros::Time(12.5);
+  msg.pose.pose.position.x = 1.5;
+  msg.pose.pose.position.y = -2.0;
+  msg.pose.pose.position.z = 0.3;                      // the planar part is taken
+  msg.pose.pose.orientation.z = 2.0 * std::sin(0.25);  // yaw 0.5, twice the unit length
+  msg.pose.pose.orientation.w = 2.0 * std::cos(0.25);
+  msg.pose.covariance[0] = 0.25;
+  msg.pose.covariance[1] = msg.pose.covariance[6] = 0.01;
+  msg.pose.covariance[7] = 0.36;
+  msg.pose.covariance[35] = 0.07;
+  msg.pose.covariance[5] = msg.pose.covariance[30] = 0.002;
+  msg.pose.covariance[14] = 99.0;  // z: not planar, ignored
+  return msg;
+}
+
+TEST(PoseRequest, APoseInOdomFrameGivesThePlanarPoseAndCovariance) {
+  PoseRequest request;
+  std::string error;
+  ASSERT_TRUE(poseRequestFromMsg(setPoseMsg("/odom"), "odom", &request, &error)) << error;
+  EXPECT_DOUBLE_EQ(request.stamp, 12.5);
+  EXPECT_DOUBLE_EQ(request.pose.x, 1.5);
+  EXPECT_DOUBLE_EQ(request.pose.y, -2.0);
+  EXPECT_NEAR(request.pose.theta, 0.5, 1e-12);
+  Eigen::Matrix3d expected;
+  expected << 0.25, 0.01, 0.002, 0.01, 0.36, 0.0, 0.002, 0.0, 0.07;
+  EXPECT_EQ(request.covariance, expected);
+  EXPECT_FALSE(request.covariance_replaced);
+}
+
+TEST(PoseRequest, AnInvalidCovarianceIsReplacedByZero) {
+  for (int index : {0, 5, 35}) {
+    geometry_msgs::PoseWithCovarianceStamped msg = setPoseMsg("odom");
+    msg.pose.covariance[index] = index == 0 ? -1.0 : kNaN;  // negative variance, asymmetric, NaN
+    PoseRequest request;
+    std::string error;
+    ASSERT_TRUE(poseRequestFromMsg(msg, "odom", &request, &error)) << error;
+    EXPECT_TRUE(request.covariance_replaced) << index;
+    EXPECT_EQ(request.covariance, Eigen::Matrix3d::Zero()) << index;
+    EXPECT_DOUBLE_EQ(request.pose.x, 1.5);
+  }
+}
+
+TEST(PoseRequest, WrongFrameNonFiniteValuesAndDegenerateQuaternionsAreRefused) {
+  PoseRequest request;
+  std::string error;
+  EXPECT_FALSE(poseRequestFromMsg(setPoseMsg("map"), "odom", &request, &error));
+  EXPECT_EQ(error, "the pose is in frame \"map\", not in odom_frame \"odom\"");
+  EXPECT_FALSE(poseRequestFromMsg(setPoseMsg(""), "odom", &request, &error));
+  EXPECT_NE(error.find("not in odom_frame"), std::string::npos);
+  geometry_msgs::PoseWithCovarianceStamped msg = setPoseMsg("odom");
+  msg.pose.pose.position.y = kInf;
+  EXPECT_FALSE(poseRequestFromMsg(msg, "odom", &request, &error));
+  EXPECT_EQ(error, "the position is not finite");
+  msg = setPoseMsg("odom");
+  msg.pose.pose.orientation.x = kNaN;
+  EXPECT_FALSE(poseRequestFromMsg(msg, "odom", &request, &error));
+  EXPECT_EQ(error, "the orientation is not finite");
+  msg = setPoseMsg("odom");
+  msg.pose.pose.orientation = geometry_msgs::Quaternion();
+  msg.pose.pose.orientation.w = 0.0;
+  EXPECT_FALSE(poseRequestFromMsg(msg, "odom", &request, &error));
+  EXPECT_NE(error.find("cannot be normalised"), std::string::npos) << error;
+  msg.pose.pose.orientation.z = 1e200;
+  msg.pose.pose.orientation.w = 1e200;
+  EXPECT_FALSE(poseRequestFromMsg(msg, "odom", &request, &error));
+  EXPECT_NE(error.find("cannot be normalised"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace hglasm_odometry

@@ -59,6 +59,8 @@ TEST(Parameters, NoParametersGiveTheMediumPresetAndDefaults) {
   EXPECT_TRUE(options.tracker.use_odometry);
   EXPECT_FALSE(options.publish_population);
   EXPECT_GE(options.queue_size, 1);
+  EXPECT_FALSE(options.set_pose.topic_enabled) << "the set-pose topic is off by default";
+  EXPECT_EQ(options.set_pose.topic, "set_pose");
 }
 
 TEST(Parameters, BuiltInPresetsSelectTheirSearchSpace) {
@@ -309,6 +311,24 @@ TEST(Parameters, SummaryMentionsThePresetAndFrames) {
   const std::string summary = summarize(options);
   EXPECT_NE(summary.find("large"), std::string::npos);
   EXPECT_NE(summary.find("odom -> base_link"), std::string::npos);
+}
+
+TEST(Parameters, SetPoseTopicIsReadAndValidated) {
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(params({{"set_pose/topic_enabled", true}, {"set_pose/topic", "/initialpose"}}),
+                          &options, &error))
+      << error;
+  EXPECT_TRUE(options.set_pose.topic_enabled);
+  EXPECT_EQ(options.set_pose.topic, "/initialpose");
+  EXPECT_EQ(loadError(params({{"set_pose/topic_enabled", "yes"}})),
+            "parameter ~set_pose/topic_enabled must be true or false, got string \"yes\"");
+  EXPECT_EQ(loadError(params({{"set_pose/topic", "2d pose"}})),
+            "parameter ~set_pose/topic must be a relative or absolute topic name, got string \"2d pose\"");
+  EXPECT_NE(loadError(params({{"set_pose/topic", "~initialpose"}})).find("~set_pose/topic"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"set_pose/topic", ""}})).find("~set_pose/topic must be a non-empty string"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -12,6 +12,9 @@
 //       tests run in any order (the .test file shuffles them): each starts from the same plain state of
 //       A and B (the fixture's SetUp), and what must hold throughout (B independent of A's faults, nothing
 //       NaN) is checked after every test (TearDown).
+//   SetPoseRos.*  (set_pose.test): ~set_pose on /odo_s (wheel odometry, the set-pose topic off by default)
+//       and the set-pose topic on /odo_t (enabled, /t/initialpose): the next poses continue from the set
+//       pose, a pose in another frame is refused.
 //   Overload.*    (robustness_overload.test): 40 Hz scans of 1081 beams with the large preset for 60 s:
 //       every scan is either processed or counted as dropped, the diagnostics report the drops, the
 //       manager's memory does not grow.
@@ -36,11 +39,14 @@
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/LaserScan.h>
+#include <std_srvs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include "../core/test_expect.h"
 #include "../core/test_util.h"
 #include "hglasm_odometry/Match.h"
+#include "hglasm_odometry/SetPose.h"
 #include "hglasm_odometry/ros/conversions.h"
 
 namespace hglasm_odometry {
@@ -1161,6 +1167,169 @@ TEST(Overload, FortyHertzOfLargeScansDropTheOldestCountThemAndDoNotGrowMemory) {
   EXPECT_LT(peak - warm, 4 * 1024) << "manager RSS grew from " << warm << " kB to " << peak << " kB";
 }
 
+// ------------------------------------------------------------------ ~set_pose and the set-pose topic
+
+/// One scan of `robot` at simulated time t (stamped kStampOrigin + t), its wheel odometry first; the match
+/// and the ~odom published with it.
+bool scanStep(Robot& robot, double t, Match* match, nav_msgs::Odometry* odom) {
+  const ros::Time stamp(kStampOrigin + t);
+  const std::size_t index = robot.matchCount();
+  robot.publishWheel(t + 0.02, stamp + ros::Duration(0.02));
+  robot.publishScan(robot.scanAt(t, stamp));
+  if (!robot.waitForMatch(index)) return false;
+  *match = robot.match(index);
+  return robot.odomAt(stamp, odom);
+}
+
+/// A pose of the base in `frame`, stamped `stamp`, with x, y, yaw variances 0.04, 0.09, 0.01.
+geometry_msgs::PoseWithCovarianceStamped poseIn(const std::string& frame, const ros::Time& stamp,
+                                                const Pose2D& pose) {
+  geometry_msgs::PoseWithCovarianceStamped msg;
+  msg.header.frame_id = frame;
+  msg.header.stamp = stamp;
+  msg.pose.pose = poseMsgFromPose2D(pose);
+  msg.pose.covariance[0] = 0.04;
+  msg.pose.covariance[7] = 0.09;
+  msg.pose.covariance[35] = 0.01;
+  return msg;
+}
+
+/// Drives `robot` from simulated time *t to `until` (0.1 s steps): every pose is `origin_pose` composed
+/// with the true motion since `origin_t`, within 5 cm and 1 degree, and nothing resets.
+void expectContinuesFrom(Robot& robot, const Pose2D& origin_pose, double origin_t, double* t, double until,
+                         const std::string& what) {
+  for (; *t < until - 1e-9;) {
+    *t += 0.1;
+    Match match;
+    nav_msgs::Odometry odom;
+    ASSERT_TRUE(scanStep(robot, *t, &match, &odom)) << what << " at " << *t;
+    EXPECT_FALSE(match.reset) << what << " at " << *t;
+    const Pose2D expected = origin_pose * hglasm_test::relativeByHand(robot.truth(origin_t), robot.truth(*t));
+    const Pose2D got = pose2D(odom.pose.pose);
+    EXPECT_LT(hglasm_test::translationError(got, expected), 0.05)
+        << what << " at " << *t << ": " << got.x << " " << got.y << " " << got.theta << " vs " << expected.x
+        << " " << expected.y << " " << expected.theta;
+    EXPECT_LT(hglasm_test::rotationError(got, expected), deg(1.0)) << what << " at " << *t;
+  }
+}
+
+TEST(SetPoseRos, ServiceContinuesFromTheSetPoseAndRefusesAnotherFrame) {
+  ros::NodeHandle nh;
+  Robot robot(nh, RobotSetup{"/odo_s", "/s/scan", "/s/wheel_odom", "odom_s", "base_s", "laser_s",
+                             Pose2D(0.10, 0.05, 0.3), circlePath, hglasm_test::halfCircleLaser()});
+  tf2_ros::StaticTransformBroadcaster static_tf;
+  sendStaticTf(&static_tf, robot.setup());
+  ASSERT_TRUE(waitFor([&] { return robot.connected(); }, 20.0)) << "/odo_s did not connect";
+  ASSERT_TRUE(ros::service::waitForService("/odo_s/set_pose", ros::Duration(20.0)));
+  ros::WallDuration(1.0).sleep();  // for the nodelet's tf listener
+  // The set-pose topic is off by default: nobody subscribes ~set_pose.
+  ros::Publisher topic = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/odo_s/set_pose", 1);
+  double t = 0.0;
+  Match match;
+  nav_msgs::Odometry odom;
+  ASSERT_TRUE(scanStep(robot, t, &match, &odom));
+  EXPECT_TRUE(match.reset);
+  ASSERT_NO_FATAL_FAILURE(expectContinuesFrom(robot, Pose2D(), 0.0, &t, 1.0, "from the start"));
+  EXPECT_EQ(topic.getNumSubscribers(), 0u) << "the set-pose topic is subscribed by default";
+
+  // Refused: another frame, a quaternion of zero length, a non-finite position. Tracking goes on.
+  SetPose refused;
+  refused.request.pose = poseIn("map", ros::Time(kStampOrigin + t), Pose2D(1.0, 2.0, 0.5));
+  ASSERT_TRUE(ros::service::call("/odo_s/set_pose", refused));
+  EXPECT_FALSE(refused.response.success);
+  EXPECT_NE(refused.response.message.find("\"map\", not in odom_frame \"odom_s\""), std::string::npos)
+      << refused.response.message;
+  refused.request.pose = poseIn("odom_s", ros::Time(kStampOrigin + t), Pose2D(1.0, 2.0, 0.5));
+  refused.request.pose.pose.pose.orientation.w = 0.0;
+  refused.request.pose.pose.pose.orientation.z = 0.0;
+  ASSERT_TRUE(ros::service::call("/odo_s/set_pose", refused));
+  EXPECT_FALSE(refused.response.success);
+  EXPECT_NE(refused.response.message.find("cannot be normalised"), std::string::npos);
+  refused.request.pose = poseIn("odom_s", ros::Time(kStampOrigin + t), Pose2D(1.0, 2.0, 0.5));
+  refused.request.pose.pose.pose.position.x = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_TRUE(ros::service::call("/odo_s/set_pose", refused));
+  EXPECT_FALSE(refused.response.success);
+  ASSERT_NO_FATAL_FAILURE(expectContinuesFrom(robot, Pose2D(), 0.0, &t, 1.5, "after the refusals"));
+
+  // Accepted: stamped at the last scan, so the next scan is the set pose moved on by the wheels' 0.1 s.
+  const Pose2D set(3.0, -1.0, 2.0);
+  SetPose accepted;
+  accepted.request.pose = poseIn("/odom_s", ros::Time(kStampOrigin + t), set);
+  ASSERT_TRUE(ros::service::call("/odo_s/set_pose", accepted));
+  EXPECT_TRUE(accepted.response.success) << accepted.response.message;
+  const double set_t = t;
+  t += 0.1;
+  ASSERT_TRUE(scanStep(robot, t, &match, &odom));
+  EXPECT_TRUE(match.reset) << describe(match);
+  const Pose2D first = set * hglasm_test::relativeByHand(robot.truth(set_t), robot.truth(t));
+  hglasm_test::expectPoseNear(pose2D(odom.pose.pose), first, 0.005, 0.002, "first scan after ~set_pose");
+  // The covariance as given, grown by the wheels' noise over 0.1 s.
+  EXPECT_GE(odom.pose.covariance[0], 0.04);
+  EXPECT_LT(odom.pose.covariance[0], 0.045);
+  EXPECT_GE(odom.pose.covariance[7], 0.09);
+  EXPECT_LT(odom.pose.covariance[7], 0.095);
+  EXPECT_GE(odom.pose.covariance[35], 0.01);
+  EXPECT_LT(odom.pose.covariance[35], 0.011);
+  ASSERT_NO_FATAL_FAILURE(expectContinuesFrom(robot, set, set_t, &t, t + 2.0, "after ~set_pose"));
+  EXPECT_EQ(topic.getNumSubscribers(), 0u);
+
+  // ~reset stays: back to the origin.
+  std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::call("/odo_s/reset", reset));
+  t += 0.1;
+  ASSERT_TRUE(scanStep(robot, t, &match, &odom));
+  EXPECT_TRUE(match.reset);
+  hglasm_test::expectPoseNear(pose2D(odom.pose.pose), Pose2D(), 1e-9, 1e-9, "after ~reset");
+}
+
+TEST(SetPoseRos, TheEnabledTopicContinuesFromThePoseAndRefusesAnotherFrame) {
+  ros::NodeHandle nh;
+  Recorder recorder;
+  ros::Subscriber log_sub = nh.subscribe("/rosout", 1000, &Recorder::onLog, &recorder);
+  Robot robot(nh, RobotSetup{"/odo_t", "/t/scan", "", "odom_t", "base_t", "laser_t", Pose2D(),
+                             otherCirclePath, hglasm_test::halfCircleLaser()});
+  tf2_ros::StaticTransformBroadcaster static_tf;
+  sendStaticTf(&static_tf, robot.setup());
+  ros::Publisher topic = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/t/initialpose", 5);
+  ASSERT_TRUE(waitFor([&] { return robot.connected() && topic.getNumSubscribers() > 0; }, 20.0))
+      << "/odo_t did not connect or does not subscribe /t/initialpose";
+  ros::WallDuration(1.0).sleep();  // for the nodelet's tf listener
+  double t = 0.0;
+  Match match;
+  nav_msgs::Odometry odom;
+  ASSERT_TRUE(scanStep(robot, t, &match, &odom));
+  ASSERT_NO_FATAL_FAILURE(expectContinuesFrom(robot, Pose2D(), 0.0, &t, 1.0, "from the start"));
+
+  // Another frame: one warning, and tracking goes on.
+  std::size_t logs = recorder.logCount();
+  topic.publish(poseIn("odom_s", ros::Time(kStampOrigin + t), Pose2D(1.0, 2.0, 0.5)));
+  ASSERT_TRUE(
+      waitFor([&] { return !recorder.lines("/odo_t", rosgraph_msgs::Log::WARN, logs).empty(); }, 5.0));
+  const std::string warning = recorder.lines("/odo_t", rosgraph_msgs::Log::WARN, logs).front();
+  EXPECT_NE(warning.find("not in odom_frame \"odom_t\""), std::string::npos) << warning;
+  ASSERT_NO_FATAL_FAILURE(expectContinuesFrom(robot, Pose2D(), 0.0, &t, 1.5, "after the refusal"));
+
+  // Accepted (logged once taken); without wheel odometry the next scan is at the pose as given.
+  const Pose2D set(-2.0, 0.5, -1.0);
+  logs = recorder.logCount();
+  topic.publish(poseIn("odom_t", ros::Time(kStampOrigin + t), set));
+  ASSERT_TRUE(waitFor(
+      [&] {
+        for (const auto& line : recorder.lines("/odo_t", rosgraph_msgs::Log::INFO, logs)) {
+          if (line.find("continuing from") != std::string::npos) return true;
+        }
+        return false;
+      },
+      5.0));
+  t += 0.1;
+  ASSERT_TRUE(scanStep(robot, t, &match, &odom));
+  EXPECT_TRUE(match.reset);
+  hglasm_test::expectPoseNear(pose2D(odom.pose.pose), set, 1e-6, 1e-6, "first scan after the topic");
+  EXPECT_NEAR(odom.pose.covariance[0], 0.04, 1e-12);
+  EXPECT_NEAR(odom.pose.covariance[35], 0.01, 1e-12);
+  ASSERT_NO_FATAL_FAILURE(expectContinuesFrom(robot, set, t, &t, t + 2.0, "after the topic"));
+}
+
 }  // namespace
 }  // namespace hglasm_odometry
 
@@ -1175,7 +1344,7 @@ int main(int argc, char** argv) {
     // The functional suite's shared state lives only if that suite runs (it advertises topics).
     const std::string filter = testing::GTEST_FLAG(filter);
     std::unique_ptr<hglasm_odometry::Scene> scene;
-    if (filter.find("Overload") == std::string::npos) {
+    if (filter.find("Overload") == std::string::npos && filter.find("SetPoseRos") == std::string::npos) {
       scene = std::make_unique<hglasm_odometry::Scene>();
       hglasm_odometry::scene = scene.get();
     }

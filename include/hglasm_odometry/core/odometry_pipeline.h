@@ -93,6 +93,10 @@ class OdometryPipeline {
   /// laser mount and what the previous scans looked like (geometry, error state).
   void reset();
 
+  /// Restarts like reset(), but from `pose` (the base in the odometry frame at `stamp`) with `covariance`:
+  /// OdometryTracker::setPose. False (nothing changed) for invalid input.
+  bool setPose(double stamp, const Pose2D& pose, const Eigen::Matrix3d& covariance);
+
   const TrackerOptions& options() const { return tracker_.options(); }
   const ScanConversionOptions& conversion() const { return conversion_; }
   const Pose2D& pose() const { return tracker_.pose(); }

@@ -73,6 +73,10 @@ struct TrackerOptions {
 /// The variance published for what is not known (a covariance must stay finite).
 constexpr double kUnknownVariance = 1e4;
 
+/// A pose covariance (x, y, theta) a caller may hand in: finite, symmetric (to 1e-9 relative) and positive
+/// semi-definite (to rounding).
+bool isValidPoseCovariance(const Eigen::Matrix3d& covariance);
+
 /// What happened to one scan.
 struct TrackerUpdate {
   double stamp = 0.0;
@@ -134,6 +138,13 @@ class OdometryTracker {
   /// Restarts from the identity pose with an empty map (odometry history and learned noise kept).
   void reset();
 
+  /// Restarts like reset(), but from `pose` (the base in the odometry frame at `stamp`, seconds) with
+  /// `covariance` (x, y, theta): the next scan becomes the first keyframe, at `pose` composed with the wheel
+  /// motion from `stamp` to the scan's stamp (and its noise) when wheel odometry covers both, else at `pose`
+  /// as given. Returns false and changes nothing for a non-finite stamp or pose or an invalid covariance
+  /// (isValidPoseCovariance).
+  bool setPose(double stamp, const Pose2D& pose, const Eigen::Matrix3d& covariance);
+
   const Pose2D& pose() const { return pose_; }
   const TrackerOptions& options() const { return options_; }
   int keyframeId() const { return keyframe_id_; }
@@ -180,6 +191,8 @@ class OdometryTracker {
   /// The new pose and its covariances from the chosen match.
   void estimateFrom(const Candidate& chosen, const Hypotheses& h, Estimate* estimate) const;
   void initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update);
+  /// At the first scan after setPose(): moves the set pose on by the wheel motion since its stamp.
+  void advanceSetPose(double stamp, TrackerUpdate* update);
   /// Match against the local map with the prediction as prior; false if the prediction is integrated.
   bool matchScan(const Scan& scan, const MotionPrediction& prediction, std::vector<Pose2D>* population_out,
                  TrackerUpdate* update, Estimate* estimate);
@@ -220,6 +233,7 @@ class OdometryTracker {
 
   bool initialised_ = false;
   double last_stamp_ = 0.0;
+  std::optional<double> set_pose_stamp_;  // setPose()'s stamp until the next scan starts from it
   Pose2D pose_;
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d map_covariance_ = Eigen::Matrix3d::Zero();  // of the laser pose in the local map's frame

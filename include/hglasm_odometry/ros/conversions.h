@@ -11,6 +11,7 @@
 
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Pose2D.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Transform.h>
 #include <nav_msgs/Odometry.h>
@@ -76,6 +77,22 @@ bool pose2DFromOdometryMsg(const nav_msgs::Odometry& msg, hglasm::Pose2D* pose);
 /// z/roll/pitch diagonal gets `unobserved_variance`.
 boost::array<double, 36> covariance6x6FromPlanar(const Eigen::Matrix3d& covariance,
                                                  double unobserved_variance = kUnobservedVariance);
+
+/// A request to continue from a given pose (~set_pose): the pose of the base in the odometry frame.
+struct PoseRequest {
+  double stamp = 0.0;  ///< seconds; 0: the message carried none (callers use now)
+  hglasm::Pose2D pose;
+  /// x, y, yaw block of the message's covariance, or zero (the pose exact) when that is not a valid
+  /// covariance (hglasm::isValidPoseCovariance).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  bool covariance_replaced = false;  ///< the message's covariance was invalid and replaced by zero
+};
+
+/// A set-pose request from a pose of the base in `odom_frame`. False, with *error saying why, if
+/// header.frame_id (without a leading slash) is not `odom_frame`, the position or the orientation is not
+/// finite, or the quaternion cannot be normalised (length below 1e-6).
+bool poseRequestFromMsg(const geometry_msgs::PoseWithCovarianceStamped& msg, const std::string& odom_frame,
+                        PoseRequest* request, std::string* error);
 
 /// "/laser" -> "laser": tf2 rejects frame ids with a leading slash, old bags (ccny) still carry them.
 std::string stripLeadingSlash(const std::string& frame_id);

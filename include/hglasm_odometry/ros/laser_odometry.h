@@ -2,8 +2,9 @@
 // diagnostics out. Shared by the nodelet and the node; holds no global state, so several instances can
 // live in one process.
 //
-// Threads: the subscription callbacks and ~reset only enqueue (scans in a bounded queue that drops the
-// oldest and counts it, wheel-odometry samples, a reset request) under one mutex and wake the worker
+// Threads: the subscription callbacks, ~reset and ~set_pose only enqueue (scans in a bounded queue that
+// drops the oldest and counts it, wheel-odometry samples, a reset or set-pose request: the later one wins)
+// under one mutex and wake the worker
 // through one condition variable. One worker thread per instance owns the pipeline: it takes what was
 // queued, waits for odometry (hglasm::OdometryPipeline's feeding policy), converts, matches and
 // publishes. Every wait of the worker is on that condition variable with stop_ in its predicate, so
@@ -16,12 +17,14 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
@@ -30,6 +33,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "hglasm_odometry/SetPose.h"
 #include "hglasm_odometry/core/odometry_pipeline.h"
 #include "hglasm_odometry/ros/conversions.h"
 #include "hglasm_odometry/ros/parameters.h"
@@ -39,7 +43,8 @@ namespace hglasm_odometry {
 class LaserOdometry {
  public:
   /// `nh` resolves the input topics (`scan`, `odom`), `private_nh` the outputs (~odom, ~pose, ~path,
-  /// ~match, ~ga_population) and ~reset. `options` must come from loadOptions() (already validated).
+  /// ~match, ~ga_population), ~reset, ~set_pose and the set-pose topic (set_pose/topic, when enabled).
+  /// `options` must come from loadOptions() (already validated).
   LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
                 const LaserOdometryOptions& options);
   ~LaserOdometry();
@@ -59,6 +64,10 @@ class LaserOdometry {
   void scanCallback(const sensor_msgs::LaserScanConstPtr& msg);
   void odomCallback(const nav_msgs::OdometryConstPtr& msg);
   bool resetCallback(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
+  bool setPoseCallback(SetPose::Request& request, SetPose::Response& response);
+  void setPoseTopicCallback(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg);
+  /// Validates a set-pose request and queues it for the worker; false with *message saying why not.
+  bool requestPose(const geometry_msgs::PoseWithCovarianceStamped& msg, std::string* message);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   /// A wheel-odometry sample as the callback received it.
@@ -69,7 +78,8 @@ class LaserOdometry {
   };
 
   void workerLoop();
-  /// Hands the queued odometry and a requested reset to the pipeline. Called by the worker, `lock` held.
+  /// Hands the queued odometry and a requested reset or pose to the pipeline. Called by the worker, `lock`
+  /// held.
   void takeQueuedInputs();
   /// Waits (bounded by options_.odometry_wait) until the pipeline's feeding policy lets a scan at `stamp`
   /// be processed (wheel odometry at or after it has arrived, or none is to be expected). False if the
@@ -98,6 +108,7 @@ class LaserOdometry {
   std::deque<OdometrySample> odometry_;
   std::uint32_t dropped_scans_ = 0;
   bool reset_requested_ = false;
+  std::optional<PoseRequest> pose_requested_;  // a reset request clears it, and it a reset request
   bool stop_ = false;
 
   // Worker-only state (no lock: only the worker thread touches it).
@@ -134,6 +145,8 @@ class LaserOdometry {
   ros::Publisher match_pub_;
   ros::Publisher population_pub_;
   ros::ServiceServer reset_service_;
+  ros::ServiceServer set_pose_service_;
+  ros::Subscriber set_pose_sub_;
   diagnostic_updater::Updater diagnostics_;
   ros::WallTimer diagnostics_timer_;
   ros::Subscriber scan_sub_;

@@ -33,6 +33,14 @@ struct DiagnosticsOptions {
   double period = 1.0;               ///< seconds between /diagnostics messages (wall clock)
 };
 
+/// Continuing from a given pose: the ~set_pose service is always offered; a topic is optional.
+struct SetPoseOptions {
+  /// Also take geometry_msgs/PoseWithCovarianceStamped on `topic` (as the service takes them).
+  bool topic_enabled = false;
+  /// Relative names resolve in the private namespace (~set_pose); "/initialpose" takes rviz's estimates.
+  std::string topic = "set_pose";
+};
+
 struct LaserOdometryOptions {
   std::string preset = "medium";  ///< name of the preset the matcher options started from
   /// Matcher (from the preset), keyframes, failure policy, wheel odometry (use_odometry: ~use_odom, also
@@ -48,6 +56,7 @@ struct LaserOdometryOptions {
   /// Wall seconds a scan may wait for wheel odometry stamped at or after it (so the prediction is
   /// interpolated, not held from an older sample). Not waited for when odometry has stopped; 0 = never.
   double odometry_wait = 0.25;
+  SetPoseOptions set_pose;
   DiagnosticsOptions diagnostics;
 };
 
