@@ -66,12 +66,28 @@ void panelPixels(const MapFrame& frame, const MapPlotOptions& options, int* widt
   *height = std::max(200, static_cast<int>(std::lround(h * per_metre)));
 }
 
-/// What the picture's points and lines mean: "one point per 5 cm cell, grid lines every 1 m".
+/// What the picture's points and lines mean: "one point per 5 cm cell, points within 20 m, grid lines
+/// every 1 m".
 std::string mapLegend(const MapFrame& frame, const MapPlotOptions& options) {
   std::ostringstream legend;
   if (options.cell > 0.0) legend << "one point per " << options.cell * 100.0 << " cm cell, ";
+  if (options.max_range > 0.0) legend << "points within " << options.max_range << " m, ";
   legend << "grid lines every " << frame.grid << " m";
   return legend.str();
+}
+
+/// The smallest and largest of `values` once the fraction `trim` of them is dropped at either end; 0, 0
+/// for no values.
+void trimmedBounds(std::vector<double>* values, double trim, double* low, double* high) {
+  *low = *high = 0.0;
+  if (values->empty()) return;
+  const std::size_t drop =
+      std::min(values->size() / 2, static_cast<std::size_t>(std::max(0.0, trim) * values->size()));
+  std::nth_element(values->begin(), values->begin() + drop, values->end());
+  *low = (*values)[drop];
+  const std::size_t top = values->size() - 1 - drop;
+  std::nth_element(values->begin(), values->begin() + top, values->end());
+  *high = (*values)[top];
 }
 
 void writeBlock(std::ostream& out, const std::vector<Eigen::Vector2d>& points) {
@@ -93,6 +109,7 @@ std::vector<Eigen::Vector2d> mapPoints(const std::vector<std::vector<Eigen::Vect
   for (std::size_t i = 0; i < count; i += step) {
     if (!laser_poses[i].isFinite()) continue;
     for (const Eigen::Vector2d& local : scans[i]) {
+      if (options.max_range > 0.0 && local.norm() > options.max_range) continue;
       const Eigen::Vector2d world = laser_poses[i] * local;
       if (!world.allFinite()) continue;
       if (options.cell > 0.0) {
@@ -153,17 +170,16 @@ std::vector<MapView> laserAndWheelViews(const std::vector<double>& stamps,
 
 MapFrame mapFrame(const std::vector<std::vector<Eigen::Vector2d>>& view_points,
                   const MapPlotOptions& options) {
-  double x_min = std::numeric_limits<double>::infinity(), y_min = x_min;
-  double x_max = -x_min, y_max = -x_min;
+  std::vector<double> xs, ys;
   for (const auto& points : view_points) {
     for (const auto& p : points) {
-      x_min = std::min(x_min, p.x());
-      x_max = std::max(x_max, p.x());
-      y_min = std::min(y_min, p.y());
-      y_max = std::max(y_max, p.y());
+      xs.push_back(p.x());
+      ys.push_back(p.y());
     }
   }
-  if (!(x_min <= x_max)) x_min = x_max = y_min = y_max = 0.0;  // no points
+  double x_min = 0.0, x_max = 0.0, y_min = 0.0, y_max = 0.0;
+  trimmedBounds(&xs, options.frame_trim, &x_min, &x_max);
+  trimmedBounds(&ys, options.frame_trim, &y_min, &y_max);
   const double margin = std::max(0.0, options.margin);
   const double extent = std::max({x_max - x_min + 2.0 * margin, y_max - y_min + 2.0 * margin, 1e-3});
   const double per_metre = std::max(1, options.panel_pixels) / extent;

@@ -70,6 +70,10 @@ TEST(MapPlot, OnePointPerCellSkippedScansAndPoses) {
   points = mapPoints(scans, poses, options);
   ASSERT_EQ(points.size(), 3u);
   EXPECT_EQ(points[2], Eigen::Vector2d(5.0, 0.0));
+  options.max_range = 4.0;  // the point 5 m from the laser is left out
+  points = mapPoints(scans, poses, options);
+  ASSERT_EQ(points.size(), 2u);
+  EXPECT_EQ(points[1], Eigen::Vector2d(1.0, 0.0));
 }
 
 TEST(MapPlot, LaserPosesIncludeTheMountAndAlignTheWheels) {
@@ -110,6 +114,16 @@ TEST(MapPlot, FrameIsRoundedToTheGridAndSharedByTheViews) {
   const MapFrame large = mapFrame({{{0.0, 0.0}, {499.0, 10.0}}}, options);
   EXPECT_DOUBLE_EQ(large.grid, 2.0);
   EXPECT_DOUBLE_EQ(large.label, 50.0);
+  // Two stray far points among 1000 in [0, 9.99] x [0, 0.999] do not stretch the frame.
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 1000; ++i) points.emplace_back(0.01 * i, 0.001 * i);
+  points.emplace_back(50.0, -30.0);
+  points.emplace_back(-40.0, 60.0);
+  const MapFrame trimmed = mapFrame({points}, options);
+  EXPECT_DOUBLE_EQ(trimmed.x_min, -1.0);
+  EXPECT_DOUBLE_EQ(trimmed.x_max, 11.0);
+  EXPECT_DOUBLE_EQ(trimmed.y_min, -1.0);
+  EXPECT_DOUBLE_EQ(trimmed.y_max, 2.0);
 }
 
 TEST(MapPlot, ScriptHasEqualScaleSharedRangesAndTheMetreGrid) {
@@ -125,7 +139,8 @@ TEST(MapPlot, ScriptHasEqualScaleSharedRangesAndTheMetreGrid) {
   views[1].colour = "#d62728";
   const std::string script = mapPlotScript("map.png", "map.dat", views, frame, options);
   EXPECT_NE(script.find("set size ratio -1\n"), std::string::npos);
-  EXPECT_NE(script.find("title 'fr079 (one point per 5 cm cell, grid lines every 1 m)'"), std::string::npos);
+  EXPECT_NE(script.find("title 'fr079 (one point per 5 cm cell, points within 20 m, grid lines every 1 m)'"),
+            std::string::npos);
   EXPECT_NE(script.find("set xrange [-2:38]\n"), std::string::npos);
   EXPECT_NE(script.find("set yrange [-5:15]\n"), std::string::npos);
   EXPECT_NE(script.find("set xtics 5\n"), std::string::npos);

@@ -13,13 +13,15 @@
 namespace hglasm {
 
 struct MapPlotOptions {
-  double cell = 0.05;       ///< metres: at most one point per cell of this size and view (<= 0: all points)
-  int scan_step = 1;        ///< draw every n-th scan
-  double grid = 1.0;        ///< metres between grid lines (widened only if lines would be < 4 px apart)
-  double margin = 1.0;      ///< metres of frame around the points
-  int panel_pixels = 900;   ///< pixels of a panel's longer side
-  std::string title;        ///< above the panels
-  bool keep_files = false;  ///< keep the data file and the script next to the PNG
+  double cell = 0.05;         ///< metres: at most one point per cell of this size and view (<= 0: all points)
+  int scan_step = 1;          ///< draw every n-th scan
+  double max_range = 20.0;    ///< metres: farther points (sparse, least precise) are left out; <= 0: none
+  double grid = 1.0;          ///< metres between grid lines (widened only if lines would be < 4 px apart)
+  double margin = 1.0;        ///< metres of frame around the points
+  double frame_trim = 0.002;  ///< fraction of the points that may lie beyond each side of the frame
+  int panel_pixels = 900;     ///< pixels of a panel's longer side
+  std::string title;          ///< above the panels
+  bool keep_files = false;    ///< keep the data file and the script next to the PNG
 };
 
 /// One drawing of the scans: where the laser was at each scan by one odometry.
@@ -37,8 +39,8 @@ struct MapFrame {
 };
 
 /// The points of `scans` (each in its laser frame) at `laser_poses` (one per scan): every
-/// options.scan_step-th scan with a finite pose, one point per options.cell square (the first one seen),
-/// in scan order.
+/// options.scan_step-th scan with a finite pose, its points within options.max_range of the laser, one point
+/// per options.cell square (the first one seen), in scan order.
 std::vector<Eigen::Vector2d> mapPoints(const std::vector<std::vector<Eigen::Vector2d>>& scans,
                                        const std::vector<Pose2D>& laser_poses, const MapPlotOptions& options);
 
@@ -60,8 +62,9 @@ std::vector<MapView> laserAndWheelViews(const std::vector<double>& stamps,
                                         const std::vector<StampedPose>& wheel_odometry,
                                         const Pose2D& base_to_laser);
 
-/// Bounds of all points plus options.margin, rounded out to whole grid lines; the grid spacing and the
-/// labelled tics' spacing for panels of options.panel_pixels.
+/// Bounds of the points (but for the options.frame_trim fraction beyond each end of either axis: stray
+/// far points) plus options.margin, rounded out to whole grid lines; the grid spacing and the labelled
+/// tics' spacing for panels of options.panel_pixels.
 MapFrame mapFrame(const std::vector<std::vector<Eigen::Vector2d>>& view_points,
                   const MapPlotOptions& options);
 
