@@ -2,7 +2,8 @@
 # THE demo: installs what is missing (apt, by Debian package name), builds the package (Release, ./build),
 # replays bags/fr079_slice.bag through the laser-odometry nodelet with simulated time, prints progress and a
 # summary (scans processed, time per scan, fallbacks, accuracy against the slice's reference relations) and
-# writes a trajectory plot to ./output/trajectory.png.
+# writes a trajectory plot to ./output/trajectory.png and a map picture (the scans at the laser odometry's
+# poses beside the same scans at the wheels') to ./output/map.png.
 #
 #   scripts/demo.sh [--rviz] [--preset small|medium|large] [--bag FILE.bag] [--rate FACTOR]
 #
@@ -22,7 +23,7 @@ while (($#)); do
     --preset) PRESET="$2"; shift ;;
     --bag) BAG="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift ;;
     --rate) RATE="$2"; shift ;;
-    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo: unknown argument $1 (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -90,5 +91,5 @@ stop_launch
 
 echo "[demo] 4/4 plot"
 gnuplot "$ROOT/output/trajectory.gp"
-echo "[demo] wrote $ROOT/output/trajectory.png (summary: $ROOT/output/summary.txt, logs: $ROOT/output/*.log)"
+echo "[demo] wrote $ROOT/output/trajectory.png and $ROOT/output/map.png (summary: $ROOT/output/summary.txt, logs: $ROOT/output/*.log)"
 exit $REPORT_STATUS

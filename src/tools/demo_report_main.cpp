@@ -1,7 +1,8 @@
 // demo_report: the demo's live reporter. Connects to the running laser odometry, resumes the paused bag
 // player once everything is connected, prints progress while the bag plays, then a summary (scans
 // processed, time per scan from ~match, fallbacks, accuracy against reference relations next to the bag's
-// wheel odometry), and writes the trajectories plus a gnuplot script for the plot.
+// wheel odometry), and writes the trajectories plus a gnuplot script for the plot, and the map picture
+// (the bag's scans at the laser odometry's poses beside the wheels').
 //
 //   demo_report --bag B [--relations R] [--output-dir DIR] [--odom-topic T] [--match-topic T]
 //               [--player /player] [--timeout SEC]
@@ -24,9 +25,11 @@
 
 #include "hglasm_odometry/Match.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
+#include "hglasm_odometry/evaluation/map_plot.h"
 #include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/conversions.h"
 #include "hglasm_odometry/tools/argument_parser.h"
+#include "hglasm_odometry/tools/bag_reader.h"
 
 namespace {
 
@@ -282,6 +285,41 @@ void writePlot(const Options& options, const std::vector<hglasm::StampedPose>& t
               dir.c_str());
 }
 
+/// options.output_dir/map.png: the bag's scans (in the laser frame, mirrored for an upside-down laser) at
+/// the laser poses of the laser odometry and, beside them, of the wheel odometry started at the same pose.
+void writeMap(const Options& options, const std::vector<hglasm::StampedPose>& trajectory,
+              const std::vector<hglasm::StampedPose>& wheel_trajectory) {
+  hglasm_odometry::BagReadOptions read_options;
+  read_options.scan_topic = options.scan_topic;
+  read_options.odom_topic = options.wheel_odom_topic;  // its child frame is the base frame of the mount
+  hglasm_odometry::BagData data;
+  std::string error;
+  if (!hglasm_odometry::readBag(options.bag, read_options, &data, &error)) {
+    std::printf("  map                 cannot read %s: %s\n", options.bag.c_str(), error.c_str());
+    return;
+  }
+  const hglasm::ScanConversionOptions conversion =
+      hglasm::conversionForMount(hglasm::ScanConversionOptions(), data.laser_upside_down);
+  const hglasm::Pose2D mount = data.has_laser_mount ? data.base_to_laser : hglasm::Pose2D();
+  std::vector<double> stamps;
+  std::vector<std::vector<Eigen::Vector2d>> scans;
+  for (const auto& bag_scan : data.scans) {
+    stamps.push_back(bag_scan.stamp);
+    scans.push_back(hglasm::scanFromRanges(bag_scan.ranges, conversion).points);
+  }
+  const std::vector<hglasm::MapView> views =
+      hglasm::laserAndWheelViews(stamps, trajectory, wheel_trajectory, mount);
+  hglasm::MapPlotOptions map_options;
+  map_options.title = "hglasm_odometry on " + options.bag.substr(options.bag.find_last_of('/') + 1) +
+                      ": scans at the laser poses";
+  const std::string png = options.output_dir + "/map.png";
+  if (hglasm::writeMapPlot(png, scans, views, map_options, &error)) {
+    std::printf("  map                 %s\n", png.c_str());
+  } else {
+    std::printf("  map                 not written: %s\n", error.c_str());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -326,6 +364,7 @@ int main(int argc, char** argv) {
   printRunSummary(options, received, expected, wall);
   printAccuracy(options, trajectory, wheel_trajectory);
   writePlot(options, trajectory, wheel_trajectory);
+  writeMap(options, trajectory, wheel_trajectory);
   std::printf("===============================================================\n");
   return received.odometry.size() == expected ? 0 : 1;
 }

@@ -17,6 +17,7 @@
 #include "hglasm_odometry/core/odometry_pipeline.h"
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
+#include "hglasm_odometry/evaluation/map_plot.h"
 #include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/parameters.h"
 #include "hglasm_odometry/tools/argument_parser.h"
@@ -41,6 +42,8 @@ const char kUsage[] =
     "                          increment covariance since the previous scan (xx xy xt yy yt tt)\n"
     "  --trace F               write one line per scan: what the tracker decided and why\n"
     "  --plot F.png            plot laser and wheel odometry trajectories (gnuplot)\n"
+    "  --map F.png             draw every scan at the laser odometry's poses beside the same scans at the\n"
+    "                          wheel odometry's (gnuplot; metre grid, equal axis scale)\n"
     "  --no-odom               do not feed wheel odometry to the tracker (constant-velocity prior)\n"
     "  --min-scan-interval S   skip scans stamped less than S s after the last processed one\n"
     "  --laser-mount X,Y,YAW   base -> laser (m, m, rad) instead of the bag's tf\n"
@@ -66,6 +69,7 @@ struct Arguments {
   std::string out;
   std::string trace;
   std::string plot;
+  std::string map;
   bool use_odometry = true;
   double min_scan_interval = 0.0;
   bool override_mount = false;
@@ -107,6 +111,7 @@ hglasm_odometry::ArgumentParser::Result parseArguments(int argc, char** argv, Ar
   parser.addOption("--out", &args->out);
   parser.addOption("--trace", &args->trace);
   parser.addOption("--plot", &args->plot);
+  parser.addOption("--map", &args->map);
   parser.addFlag("--no-odom", &args->use_odometry, false);
   parser.addFlag("--quiet", &args->quiet);
   parser.addFlag("--direct-pairs", &args->direct_pairs);
@@ -636,9 +641,37 @@ bool readInputs(const Arguments& args, const std::string& base_frame, hglasm_odo
   return true;
 }
 
-/// --out, --trace and --plot, each if asked for.
+/// The map picture: every scan (the pipeline's conversion, mirrored for an upside-down laser) drawn at the
+/// laser poses of the laser odometry and, beside them, of the wheel odometry started at the same pose.
+bool plotMap(const Arguments& args, const std::string& title, const hglasm::TrackerOptions& options,
+             const hglasm_odometry::BagData& data, const Run& run,
+             const std::vector<hglasm::StampedPose>& wheel_trajectory) {
+  hglasm::OdometryPipeline pipeline(options);
+  hglasm_odometry::setLaserMount(data, &pipeline);
+  const hglasm::Pose2D mount = data.has_laser_mount ? data.base_to_laser : hglasm::Pose2D();
+  std::vector<double> stamps;
+  std::vector<std::vector<Eigen::Vector2d>> scans;
+  for (const auto& bag_scan : data.scans) {
+    stamps.push_back(bag_scan.stamp);
+    scans.push_back(hglasm::scanFromRanges(rangesOf(args, bag_scan), pipeline.conversion()).points);
+  }
+  const std::vector<hglasm::MapView> views =
+      hglasm::laserAndWheelViews(stamps, run.trajectory, wheel_trajectory, mount);
+  hglasm::MapPlotOptions map_options;
+  map_options.title = title + ": scans at the laser poses";
+  std::string error;
+  if (!hglasm::writeMapPlot(args.map, scans, views, map_options, &error)) {
+    std::cerr << "evaluate: " << error << "\n";
+    return false;
+  }
+  std::printf("map           %s\n", args.map.c_str());
+  return true;
+}
+
+/// --out, --trace, --plot and --map, each if asked for.
 bool writeOutputs(const Arguments& args, const std::string& preset, const Run& run,
-                  const std::vector<hglasm::StampedPose>& wheel_trajectory) {
+                  const std::vector<hglasm::StampedPose>& wheel_trajectory,
+                  const hglasm::TrackerOptions& options, const hglasm_odometry::BagData& data) {
   if (!args.out.empty()) {
     if (!writeTrajectory(args.out, run.trajectory, &run.updates)) {
       std::cerr << "evaluate: cannot write " << args.out << "\n";
@@ -653,15 +686,15 @@ bool writeOutputs(const Arguments& args, const std::string& preset, const Run& r
     }
     std::printf("trace         %s\n", args.trace.c_str());
   }
+  const std::string title = args.bag.substr(args.bag.find_last_of('/') + 1) + ", preset " + preset;
   if (!args.plot.empty()) {
-    const std::string title = args.bag.substr(args.bag.find_last_of('/') + 1) + ", preset " + preset;
     if (!plotTrajectories(args.plot, title, run.trajectory, wheel_trajectory)) {
       std::cerr << "evaluate: gnuplot failed for " << args.plot << "\n";
       return false;
     }
     std::printf("plot          %s\n", args.plot.c_str());
   }
-  return true;
+  return args.map.empty() || plotMap(args, title, options, data, run, wheel_trajectory);
 }
 
 }  // namespace
@@ -709,5 +742,5 @@ int main(int argc, char** argv) {
   if (!relations.empty())
     printRelations(args, nodelet_options.preset, run, relations, wheel_trajectory, options, data);
 
-  return writeOutputs(args, nodelet_options.preset, run, wheel_trajectory) ? 0 : 1;
+  return writeOutputs(args, nodelet_options.preset, run, wheel_trajectory, options, data) ? 0 : 1;
 }
