@@ -24,9 +24,11 @@ void LocalMap::clear() {
   keyframes_.clear();
   reference_.clear();
   frame_ = Pose2D();
+  ++revision_;
 }
 
 void LocalMap::rebuild() {
+  ++revision_;
   reference_.clear();
   cells_.clear();
   if (keyframes_.empty()) return;

@@ -5,6 +5,8 @@
 #include <limits>
 #include <utility>
 
+#include <sensor_msgs/point_cloud2_iterator.h>
+
 namespace hglasm_odometry {
 namespace {
 
@@ -360,6 +362,35 @@ visualization_msgs::MarkerArray populationMarkers(const std_msgs::Header& header
   markers.markers.push_back(arrowMarker(header, 1, estimate, 0.1f, 0.9f, 0.1f));
   markers.markers.push_back(arrowMarker(header, 2, guess, 0.2f, 0.4f, 1.0f));
   return markers;
+}
+
+sensor_msgs::PointCloud2 pointCloudMsgFromPoints(const std_msgs::Header& header, const hglasm::Pose2D& frame,
+                                                 const std::vector<Eigen::Vector2d>& points) {
+  std::vector<Eigen::Vector2f> moved;
+  moved.reserve(points.size());
+  if (frame.isFinite()) {
+    for (const Eigen::Vector2d& point : points) {
+      const Eigen::Vector2f p = (frame * point).cast<float>();
+      if (p.allFinite()) moved.push_back(p);
+    }
+  }
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header = header;
+  sensor_msgs::PointCloud2Modifier modifier(cloud);
+  modifier.setPointCloud2Fields(3, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1,
+                                sensor_msgs::PointField::FLOAT32, "z", 1, sensor_msgs::PointField::FLOAT32);
+  modifier.resize(moved.size());  // height 1, width = size: one unordered row
+  cloud.is_dense = true;
+  sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
+  for (const Eigen::Vector2f& p : moved) {
+    *x = p.x();
+    *y = p.y();
+    *z = 0.0f;
+    ++x;
+    ++y;
+    ++z;
+  }
+  return cloud;
 }
 
 }  // namespace hglasm_odometry

@@ -9,6 +9,7 @@
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Path.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "hglasm_odometry/Match.h"
@@ -53,6 +54,8 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
   if (options_.publish_population) {
     population_pub_ = private_nh_.advertise<visualization_msgs::MarkerArray>("ga_population", 2);
   }
+  local_map_pub_ = private_nh_.advertise<sensor_msgs::PointCloud2>(
+      "local_map", 2, [this](const ros::SingleSubscriberPublisher&) { local_map_resend_ = true; });
   reset_service_ = private_nh_.advertiseService("reset", &LaserOdometry::resetCallback, this);
   set_pose_service_ = private_nh_.advertiseService("set_pose", &LaserOdometry::setPoseCallback, this);
 
@@ -344,6 +347,7 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
 
   publish(msg, result, msSince(start));
   if (want_population && update.matched) publishPopulation(msg.header.stamp, update, population);
+  publishLocalMap(msg.header.stamp);
 
   ScanRecord record;
   record.time = ros::WallTime::now();
@@ -404,6 +408,19 @@ void LaserOdometry::publishPose(const ros::Time& stamp, const hglasm::TrackerUpd
       path_pub_.publish(path);
     }
   }
+}
+
+void LaserOdometry::publishLocalMap(const ros::Time& stamp) {
+  if (local_map_pub_.getNumSubscribers() == 0) return;  // nothing is built for nobody
+  const hglasm::LocalMap& map = pipeline_.localMap();
+  const bool resend = local_map_resend_.exchange(false);
+  if (!resend && local_map_sent_ && map.revision() == local_map_revision_) return;
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = options_.odom_frame;
+  local_map_pub_.publish(pointCloudMsgFromPoints(header, map.frame(), map.reference().points));
+  local_map_sent_ = true;
+  local_map_revision_ = map.revision();
 }
 
 void LaserOdometry::publishPopulation(const ros::Time& stamp, const hglasm::TrackerUpdate& update,

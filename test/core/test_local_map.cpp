@@ -118,6 +118,20 @@ TEST(LocalMap, SurfacesAreNeverJoinedAcrossKeyframes) {
   EXPECT_EQ(same, (std::vector<std::uint8_t>{1, 0, 1, 0}));
 }
 
+TEST(LocalMap, RevisionChangesWithEveryAddAndClearOnly) {
+  LocalMap map;
+  const auto initial = map.revision();
+  map.add(Pose2D(), wall(2.0));
+  const auto first = map.revision();
+  EXPECT_NE(first, initial);
+  EXPECT_EQ(map.revision(), first) << "reading the map changes nothing";
+  map.add(Pose2D(0.5, 0.0, 0.0), wall(2.5));
+  const auto second = map.revision();
+  EXPECT_NE(second, first);
+  map.clear();
+  EXPECT_NE(map.revision(), second);
+}
+
 TEST(LocalMap, AtLeastOneKeyframe) {
   LocalMapOptions options;
   options.keyframes = 0;

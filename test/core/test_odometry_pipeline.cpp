@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -224,6 +225,55 @@ TEST(OdometryPipeline, SetPoseRestartsFromThePoseAndKeepsTheMount) {
   hglasm_test::expectPoseNear(*second.laser_guess, Pose2D(), 1e-9, 1e-9, "guess after set");
   hglasm_test::expectPoseNear(second.tracker.match.pose, mount.inverse() * Pose2D(0.05, 0.0, 0.0) * mount,
                               0.01, 0.005, "match after set");
+}
+
+/// The local map the pipeline exposes (the node's ~local_map): the newest keyframe's laser pose is its
+/// frame, its points lie on the room's walls once moved into the odometry frame, and its revision changes
+/// exactly at the scans that made a keyframe.
+TEST(OdometryPipeline, ExposesTheLocalMapInTheOdometryFrameAndItsRevisionPerKeyframe) {
+  TrackerOptions options;
+  options.use_odometry = false;
+  OdometryPipeline pipeline(options);
+  const Pose2D mount(0.3, 0.1, 0.4);
+  pipeline.setLaserMount(mount, false);
+  EXPECT_TRUE(pipeline.localMap().empty());
+  auto revision = pipeline.localMap().revision();
+  int keyframes = 0;
+  for (int i = 0; i <= 20; ++i) {
+    const double t = 0.1 * i;
+    const PipelineUpdate update =
+        pipeline.processScan(t, rangesAt(hglasm_test::composeByHand(straightAt(t), mount), false));
+    ASSERT_TRUE(update.tracker.published);
+    const bool changed = pipeline.localMap().revision() != revision;
+    revision = pipeline.localMap().revision();
+    EXPECT_EQ(changed, update.tracker.new_keyframe) << "scan " << i;
+    keyframes += update.tracker.new_keyframe;
+    if (!update.tracker.new_keyframe) continue;
+    hglasm_test::expectPoseNear(pipeline.localMap().frame(), update.tracker.pose * mount, 1e-9, 1e-9,
+                                "map frame");
+  }
+  EXPECT_GE(keyframes, 3) << "1 m at 0.30 m per keyframe";
+  const hglasm::LocalMap& map = pipeline.localMap();
+  ASSERT_FALSE(map.reference().empty());
+  // Moved into the odometry frame (= the room's frame: the run starts at its origin), the points lie on
+  // what the laser saw from its true poses: within a few cm of the points simulated there.
+  std::vector<Eigen::Vector2d> room;
+  for (int i = 0; i <= 20; ++i) {
+    const Pose2D truth_pose = hglasm_test::composeByHand(straightAt(0.1 * i), mount);
+    const hglasm::Scan truth = hglasm::scanFromRanges(rangesAt(truth_pose, false), options.conversion);
+    for (const Eigen::Vector2d& p : truth.points) room.push_back(truth_pose * p);
+  }
+  int near = 0;
+  for (const Eigen::Vector2d& p : map.reference().points) {
+    const Eigen::Vector2d in_odom = map.frame() * p;
+    double best = 1e9;
+    for (const Eigen::Vector2d& q : room) best = std::min(best, (q - in_odom).norm());
+    near += best < 0.05;
+  }
+  EXPECT_GT(near, 0.8 * map.reference().size());
+  pipeline.reset();
+  pipeline.processScan(2.1, rangesAt(hglasm_test::composeByHand(straightAt(2.1), mount), false));
+  EXPECT_NE(pipeline.localMap().revision(), revision) << "a reset rebuilds the map";
 }
 
 }  // namespace

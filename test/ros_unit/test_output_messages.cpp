@@ -1,10 +1,17 @@
 // The node's outgoing messages from a tracker update: ~odom (frames, pose, covariances, a non-finite
 // velocity), ~match (enum constants, clamped counts, NaN-free floats, poses only for attempted matches, the
-// scan's frame) and the ~ga_population markers (finite individuals only, heading segments, arrows).
+// scan's frame), the ~ga_population markers (finite individuals only, heading segments, arrows) and the
+// ~local_map cloud (fields, frame, points moved into odom_frame, finite only; not latched per the README).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <sensor_msgs/point_cloud2_iterator.h>
 
 #include "hglasm_odometry/ros/conversions.h"
 
@@ -218,6 +225,75 @@ TEST(PopulationMarkers, EmptyPopulationStillDrawsTheArrows) {
       populationMarkers(makeHeader(4.0, "odom"), {}, hglasm::Pose2D(), hglasm::Pose2D());
   ASSERT_EQ(markers.markers.size(), 3u);
   EXPECT_TRUE(markers.markers[0].points.empty());
+}
+
+/// The x, y, z values of a cloud's points, read through its fields' offsets.
+std::vector<Eigen::Vector3f> cloudPoints(const sensor_msgs::PointCloud2& cloud) {
+  std::vector<Eigen::Vector3f> points;
+  sensor_msgs::PointCloud2ConstIterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
+  for (; x != x.end(); ++x, ++y, ++z) points.emplace_back(*x, *y, *z);
+  return points;
+}
+
+TEST(LocalMapCloud, PointsMovedIntoTheHeadersFrameAsXYZFloat32) {
+  const std_msgs::Header header = makeHeader(12.5, "odom");
+  // The map's frame: 1 m ahead, 2 m left, turned a quarter: (1, 0) lands at (1, 3), (0, -1) at (2, 2).
+  const hglasm::Pose2D frame(1.0, 2.0, M_PI / 2);
+  const std::vector<Eigen::Vector2d> points{{1.0, 0.0}, {0.0, -1.0}, {0.0, 0.0}};
+  const sensor_msgs::PointCloud2 cloud = pointCloudMsgFromPoints(header, frame, points);
+  EXPECT_EQ(cloud.header.frame_id, "odom");
+  EXPECT_EQ(cloud.header.stamp, ros::Time(12.5));
+  EXPECT_EQ(cloud.height, 1u);
+  EXPECT_EQ(cloud.width, 3u);
+  EXPECT_TRUE(cloud.is_dense);
+  EXPECT_FALSE(cloud.is_bigendian);
+  ASSERT_EQ(cloud.fields.size(), 3u);
+  const char* names[] = {"x", "y", "z"};
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(cloud.fields[i].name, names[i]);
+    EXPECT_EQ(cloud.fields[i].datatype, sensor_msgs::PointField::FLOAT32);
+    EXPECT_EQ(cloud.fields[i].count, 1u);
+    EXPECT_EQ(cloud.fields[i].offset, 4u * i);
+  }
+  EXPECT_EQ(cloud.point_step, 12u);
+  EXPECT_EQ(cloud.row_step, 36u);
+  EXPECT_EQ(cloud.data.size(), 36u);
+  const std::vector<Eigen::Vector3f> got = cloudPoints(cloud);
+  ASSERT_EQ(got.size(), 3u);
+  const std::vector<Eigen::Vector3f> expected{{1.0f, 3.0f, 0.0f}, {2.0f, 2.0f, 0.0f}, {1.0f, 2.0f, 0.0f}};
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR((got[i] - expected[i]).norm(), 0.0f, 1e-6f) << i;
+}
+
+TEST(LocalMapCloud, NonFinitePointsAreLeftOutAndANonFiniteFrameGivesNone) {
+  const std_msgs::Header header = makeHeader(1.0, "odom");
+  const std::vector<Eigen::Vector2d> points{{1.0, 0.0}, {kNaN, 0.0}, {1e300, 0.0}, {0.0, 2.0}};
+  const sensor_msgs::PointCloud2 cloud = pointCloudMsgFromPoints(header, hglasm::Pose2D(), points);
+  const std::vector<Eigen::Vector3f> got = cloudPoints(cloud);
+  ASSERT_EQ(got.size(), 2u) << "NaN and a point beyond float's range are left out";
+  EXPECT_EQ(cloud.width, 2u);
+  EXPECT_EQ(got[0], Eigen::Vector3f(1.0f, 0.0f, 0.0f));
+  EXPECT_EQ(got[1], Eigen::Vector3f(0.0f, 2.0f, 0.0f));
+  hglasm::Pose2D bad;
+  bad.x = kNaN;
+  const sensor_msgs::PointCloud2 none = pointCloudMsgFromPoints(header, bad, points);
+  EXPECT_EQ(none.width, 0u);
+  EXPECT_TRUE(none.data.empty());
+  EXPECT_EQ(none.fields.size(), 3u) << "an empty cloud still says what its points would be";
+  EXPECT_TRUE(pointCloudMsgFromPoints(header, hglasm::Pose2D(), {}).data.empty());
+}
+
+/// The rostest checks the connection says latching 0; the README's topic table must say so too.
+TEST(LocalMapCloud, TheReadmeDocumentsTheTopicAsNotLatched) {
+  std::ifstream readme(HGLASM_SOURCE_DIR "/README.md");
+  ASSERT_TRUE(readme.good());
+  std::string line, row;
+  while (std::getline(readme, line)) {
+    if (line.rfind("| out | `~local_map` |", 0) == 0) row = line;
+  }
+  ASSERT_FALSE(row.empty()) << "no ~local_map row in the README's topics table";
+  EXPECT_NE(row.find("sensor_msgs/PointCloud2"), std::string::npos) << row;
+  EXPECT_NE(row.find("not latched"), std::string::npos) << row;
+  EXPECT_NE(row.find("only while someone subscribes"), std::string::npos) << row;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 //   relations              reference relations of the slice ("" = no accuracy check)
 //   scan_topic             /scan            odom_topic   /laser_odometry/odom
 //   match_topic            /laser_odometry/match         odometry_ns  /laser_odometry
+//   local_map_topic        <odometry_ns>/local_map
 //   odom_frame / base_frame  odom / base_link
 //   player                 /player (its pause_playback service starts the paused player)
 //   max_trans_error        metres: bound on the mean translational error over all relations
@@ -24,6 +25,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -37,6 +39,8 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/SetBool.h>
 #include <tf2_msgs/TFMessage.h>
 
@@ -59,6 +63,7 @@ struct Settings {
   std::string odom_topic = "/laser_odometry/odom";
   std::string match_topic = "/laser_odometry/match";
   std::string odometry_ns = "/laser_odometry";
+  std::string local_map_topic;  // empty: odometry_ns + "/local_map"
   std::string odom_frame = "odom";
   std::string base_frame = "base_link";
   std::string player = "/player";
@@ -79,6 +84,8 @@ struct Recording {
   std::vector<hglasm::StampedPose> wheel_odometry;  // from the bag, at the scan stamps
   std::vector<nav_msgs::Odometry> odometry;
   std::vector<Match> matches;
+  std::vector<sensor_msgs::PointCloud2> local_maps;
+  std::set<std::string> local_map_latching;  // the "latching" field of each connection's header
   std::map<ros::Time, geometry_msgs::Transform> transforms;  // odom_frame -> base_frame by stamp
   int foreign_transforms = 0;                                // other frame pairs seen on /tf
   bool started = false;
@@ -96,9 +103,9 @@ bool topicHasSubscriber(const std::string& topic) {
   return false;
 }
 
-std::unique_ptr<Recording> record() {
-  auto rec = std::make_unique<Recording>();
-  Settings& s = rec->settings;
+/// The private parameters (see the file comment).
+Settings readSettings() {
+  Settings s;
   ros::NodeHandle private_nh("~");
   private_nh.getParam("bag", s.bag);
   private_nh.getParam("relations", s.relations);
@@ -107,6 +114,8 @@ std::unique_ptr<Recording> record() {
   private_nh.getParam("odom_topic", s.odom_topic);
   private_nh.getParam("match_topic", s.match_topic);
   private_nh.getParam("odometry_ns", s.odometry_ns);
+  private_nh.getParam("local_map_topic", s.local_map_topic);
+  if (s.local_map_topic.empty()) s.local_map_topic = s.odometry_ns + "/local_map";
   private_nh.getParam("odom_frame", s.odom_frame);
   private_nh.getParam("base_frame", s.base_frame);
   private_nh.getParam("player", s.player);
@@ -118,8 +127,12 @@ std::unique_ptr<Recording> record() {
   private_nh.getParam("min_deskewed_ratio", s.min_deskewed_ratio);
   private_nh.getParam("max_deskewed_ratio", s.max_deskewed_ratio);
   private_nh.getParam("timeout", s.timeout);
+  return s;
+}
 
-  // The bag's scan stamps and wheel odometry.
+/// The bag's scan stamps (sorted) and its wheel odometry at those stamps.
+void readScanStampsAndWheelOdometry(Recording* rec) {
+  const Settings& s = rec->settings;
   hglasm::OdometryBuffer wheel(1e9);
   {
     rosbag::Bag bag(s.bag, rosbag::bagmode::Read);
@@ -140,6 +153,36 @@ std::unique_ptr<Recording> record() {
     pose.stamp = stamp.toSec();
     if (wheel.poseAt(pose.stamp, 1.0, &pose.pose)) rec->wheel_odometry.push_back(pose);
   }
+}
+
+/// Until every scan has its odometry, match and tf, or nothing arrived for a while, or the time is up.
+template <typename Elapsed>
+void waitForEveryScan(Recording* rec, const Elapsed& elapsed) {
+  const std::size_t expected = rec->scan_stamps.size();
+  std::size_t last_count = 0;
+  ros::WallTime last_progress = ros::WallTime::now();
+  while (ros::ok() && elapsed() < rec->settings.timeout) {
+    std::size_t count;
+    {
+      std::lock_guard<std::mutex> lock(rec->mutex);
+      count = std::min(rec->odometry.size(), std::min(rec->matches.size(), rec->transforms.size()));
+    }
+    if (count >= expected) break;
+    if (count != last_count) {
+      last_count = count;
+      last_progress = ros::WallTime::now();
+    } else if ((ros::WallTime::now() - last_progress).toSec() > 20.0) {
+      break;
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+}
+
+std::unique_ptr<Recording> record() {
+  auto rec = std::make_unique<Recording>();
+  rec->settings = readSettings();
+  const Settings& s = rec->settings;
+  readScanStampsAndWheelOdometry(rec.get());
 
   ros::NodeHandle nh;
   Recording* r = rec.get();
@@ -164,6 +207,16 @@ std::unique_ptr<Recording> record() {
           }
         }
       });
+  using LocalMapEvent = ros::MessageEvent<const sensor_msgs::PointCloud2>;
+  const boost::function<void(const LocalMapEvent&)> on_local_map = [r](const LocalMapEvent& event) {
+    std::lock_guard<std::mutex> lock(r->mutex);
+    r->local_maps.push_back(*event.getMessage());
+    const auto& header = event.getConnectionHeader();
+    const auto latching = header.find("latching");
+    r->local_map_latching.insert(latching == header.end() ? "(none)" : latching->second);
+  };
+  ros::Subscriber local_map_sub =
+      nh.subscribe<sensor_msgs::PointCloud2, const LocalMapEvent&>(s.local_map_topic, 10000, on_local_map);
   ros::AsyncSpinner spinner(2);
   spinner.start();
 
@@ -172,7 +225,8 @@ std::unique_ptr<Recording> record() {
   auto elapsed = [&start] { return (ros::WallTime::now() - start).toSec(); };
   while (ros::ok() && elapsed() < 30.0 &&
          (odom_sub.getNumPublishers() == 0 || match_sub.getNumPublishers() == 0 ||
-          tf_sub.getNumPublishers() == 0 || !topicHasSubscriber(s.scan_topic))) {
+          tf_sub.getNumPublishers() == 0 || local_map_sub.getNumPublishers() == 0 ||
+          !topicHasSubscriber(s.scan_topic))) {
     ros::WallDuration(0.1).sleep();
   }
   const std::string pause_service = s.player + "/pause_playback";
@@ -182,30 +236,15 @@ std::unique_ptr<Recording> record() {
     rec->started = ros::service::call(pause_service, resume);
   }
 
-  // Until every scan has its odometry, or nothing arrived for a while, or the time is up.
-  const std::size_t expected = rec->scan_stamps.size();
-  std::size_t last_count = 0;
-  ros::WallTime last_progress = ros::WallTime::now();
-  while (ros::ok() && elapsed() < s.timeout) {
-    std::size_t count;
-    {
-      std::lock_guard<std::mutex> lock(rec->mutex);
-      count = std::min(rec->odometry.size(), std::min(rec->matches.size(), rec->transforms.size()));
-    }
-    if (count >= expected) break;
-    if (count != last_count) {
-      last_count = count;
-      last_progress = ros::WallTime::now();
-    } else if ((ros::WallTime::now() - last_progress).toSec() > 20.0) {
-      break;
-    }
-    ros::WallDuration(0.1).sleep();
-  }
+  waitForEveryScan(rec.get(), elapsed);
   ros::WallDuration(0.5).sleep();  // anything still in flight (e.g. a duplicate) is caught too
   spinner.stop();
   std::lock_guard<std::mutex> lock(rec->mutex);
-  ROS_INFO("replay took %.1f s wall: %zu scans in the bag, %zu odometry, %zu match, %zu tf received",
-           elapsed(), expected, rec->odometry.size(), rec->matches.size(), rec->transforms.size());
+  ROS_INFO(
+      "replay took %.1f s wall: %zu scans in the bag, %zu odometry, %zu match, %zu tf, %zu local maps "
+      "received",
+      elapsed(), rec->scan_stamps.size(), rec->odometry.size(), rec->matches.size(), rec->transforms.size(),
+      rec->local_maps.size());
   return rec;
 }
 
@@ -365,6 +404,122 @@ TEST_F(OdometryReplay, TrajectoryMatchesTheReferenceRelations) {
   EXPECT_LE(laser_short.rot_mean_deg, r.settings.max_short_rot_error_deg) << "relations <= 10 s";
 }
 
+/// The x, y of a cloud's points; *finite false if any x, y or z is not finite.
+std::vector<Eigen::Vector2d> cloudPoints(const sensor_msgs::PointCloud2& cloud, bool* finite) {
+  std::vector<Eigen::Vector2d> points;
+  *finite = true;
+  sensor_msgs::PointCloud2ConstIterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
+  for (; x != x.end(); ++x, ++y, ++z) {
+    *finite = *finite && std::isfinite(*x) && std::isfinite(*y) && std::isfinite(*z);
+    points.emplace_back(*x, *y);
+  }
+  return points;
+}
+
+/// ~local_map comes with every keyframe (the subscriber was there from the start), in odom_frame, stamped
+/// with the keyframe's scan, non-empty and finite. A message at a scan that made no keyframe may only
+/// repeat the previous one (sent again because a subscriber connected).
+TEST_F(OdometryReplay, LocalMapIsPublishedWithEveryKeyframeInTheOdomFrame) {
+  const Recording& r = *recording_;
+  std::set<ros::Time> keyframe_stamps;
+  for (const Match& m : r.matches) {
+    if (m.new_keyframe) keyframe_stamps.insert(m.header.stamp);
+  }
+  ASSERT_FALSE(r.local_maps.empty()) << "nothing received on " << r.settings.local_map_topic;
+  std::set<ros::Time> map_stamps;
+  std::size_t min_points = std::numeric_limits<std::size_t>::max(), max_points = 0;
+  for (std::size_t i = 0; i < r.local_maps.size(); ++i) {
+    const sensor_msgs::PointCloud2& cloud = r.local_maps[i];
+    EXPECT_EQ(stripLeadingSlash(cloud.header.frame_id), r.settings.odom_frame);
+    bool finite = false;
+    const std::size_t count = cloudPoints(cloud, &finite).size();
+    EXPECT_TRUE(finite) << "local map at " << cloud.header.stamp;
+    EXPECT_GT(count, 0u) << "local map at " << cloud.header.stamp;
+    min_points = std::min(min_points, count);
+    max_points = std::max(max_points, count);
+    if (keyframe_stamps.count(cloud.header.stamp)) {
+      EXPECT_TRUE(map_stamps.insert(cloud.header.stamp).second) << "two maps for one keyframe";
+    } else {
+      ASSERT_GT(i, 0u) << "the first local map came without a keyframe, at " << cloud.header.stamp;
+      EXPECT_EQ(cloud.data, r.local_maps[i - 1].data) << "a changed map without a keyframe";
+    }
+  }
+  std::printf("[measured] %zu local maps (%zu to %zu points) for %zu keyframes\n", r.local_maps.size(),
+              min_points, max_points, keyframe_stamps.size());
+  EXPECT_EQ(map_stamps, keyframe_stamps) << "keyframes without a local map";
+}
+
+/// README: ~local_map is not latched (a new subscriber gets the current map with the next scan).
+TEST_F(OdometryReplay, LocalMapIsNotLatchedAsDocumented) {
+  EXPECT_EQ(recording_->local_map_latching, std::set<std::string>{"0"});
+}
+
+/// The node's parameters (from its private namespace) and the bag as the offline tools read it.
+BagData readReplayedBag(const Settings& settings, LaserOdometryOptions* options) {
+  std::string error;
+  std::vector<std::string> warnings;
+  EXPECT_TRUE(loadOptions(ros::NodeHandle(settings.odometry_ns), options, &error, &warnings)) << error;
+  BagReadOptions read_options;
+  read_options.scan_topic = settings.scan_topic;
+  read_options.odom_topic = options->tracker.use_odometry ? settings.wheel_odom_topic : "";
+  read_options.base_frame = options->base_frame;
+  BagData data;
+  EXPECT_TRUE(readBag(settings.bag, read_options, &data, &error)) << error;
+  return data;
+}
+
+/// The local map is what the scans are matched against: the last scan before the next map, moved into
+/// odom_frame by its published pose and the laser mount, lies on the map's points for most beams. A map
+/// in another frame, or points left in the keyframe's frame, put them metres away.
+TEST_F(OdometryReplay, ScansLieOnTheLocalMapTheyWereMatchedAgainst) {
+  constexpr double kNear = 0.05;  // metres
+  const Recording& r = *recording_;
+  ASSERT_FALSE(r.local_maps.empty());
+  LaserOdometryOptions options;
+  const BagData data = readReplayedBag(r.settings, &options);
+  const hglasm::ScanConversionOptions conversion =
+      hglasm::conversionForMount(options.tracker.conversion, data.laser_upside_down);
+  std::map<double, hglasm::Pose2D> poses;  // by stamp as readBag gives it
+  for (const auto& odom : r.odometry) {
+    hglasm::Pose2D pose;
+    if (pose2DFromOdometryMsg(odom, &pose)) poses[odom.header.stamp.toSec()] = pose;
+  }
+  double worst = 1.0, sum = 0.0;
+  int checked = 0;
+  for (std::size_t i = 0; i < r.local_maps.size(); ++i) {
+    const double from = r.local_maps[i].header.stamp.toSec();
+    const double to = i + 1 < r.local_maps.size() ? r.local_maps[i + 1].header.stamp.toSec()
+                                                  : std::numeric_limits<double>::infinity();
+    const BagScan* last = nullptr;  // the last scan matched against this map
+    for (const BagScan& scan : data.scans) {
+      if (scan.stamp > from && scan.stamp < to && poses.count(scan.stamp)) last = &scan;
+    }
+    if (last == nullptr) continue;
+    bool finite = false;
+    const std::vector<Eigen::Vector2d> map = cloudPoints(r.local_maps[i], &finite);
+    const hglasm::Pose2D laser = poses.at(last->stamp) * data.base_to_laser;
+    const hglasm::Scan scan = hglasm::scanFromRanges(last->ranges, conversion);
+    int near = 0;
+    for (const Eigen::Vector2d& point : scan.points) {
+      const Eigen::Vector2d in_odom = laser * point;
+      near += std::any_of(map.begin(), map.end(), [&](const Eigen::Vector2d& m) {
+        return (m - in_odom).squaredNorm() < kNear * kNear;
+      });
+    }
+    const double ratio = scan.points.empty() ? 0.0 : static_cast<double>(near) / scan.points.size();
+    worst = std::min(worst, ratio);
+    sum += ratio;
+    ++checked;
+  }
+  ASSERT_GT(checked, 0);
+  std::printf(
+      "[measured] %d scans against their local map: beams within %.2f m of a map point: mean %.3f, "
+      "worst %.3f\n",
+      checked, kNear, sum / checked, worst);
+  EXPECT_GE(sum / checked, 0.8);
+  EXPECT_GE(worst, 0.5);
+}
+
 /// One scan of the offline run: what the node publishes about it.
 struct OfflineScan {
   hglasm::TrackerUpdate update;
@@ -375,16 +530,7 @@ struct OfflineScan {
 /// feeding policy evaluate uses, by scan stamp.
 std::map<double, OfflineScan> runOffline(const Settings& settings) {
   LaserOdometryOptions options;
-  std::string error;
-  std::vector<std::string> warnings;
-  EXPECT_TRUE(loadOptions(ros::NodeHandle(settings.odometry_ns), &options, &error, &warnings)) << error;
-  BagReadOptions read_options;
-  read_options.scan_topic = settings.scan_topic;
-  read_options.odom_topic = options.tracker.use_odometry ? settings.wheel_odom_topic : "";
-  read_options.base_frame = options.base_frame;
-  BagData data;
-  EXPECT_TRUE(readBag(settings.bag, read_options, &data, &error)) << error;
-
+  const BagData data = readReplayedBag(settings, &options);
   hglasm::OdometryPipeline pipeline(options.tracker, options.odometry_wait > 0.0);
   setLaserMount(data, &pipeline);
   std::map<double, OfflineScan> run;

@@ -44,6 +44,9 @@ class LocalMap {
   /// Every keyframe's points in frame(), one scan per keyframe.
   const ReferencePoints& reference() const { return reference_; }
   const LocalMapOptions& options() const { return options_; }
+  /// Changes whenever reference() or frame() may have changed (every add() and clear()): consumers that
+  /// copy the map (its display) compare it with the revision they copied.
+  std::uint64_t revision() const { return revision_; }
 
  private:
   struct Keyframe {
@@ -60,6 +63,7 @@ class LocalMap {
   std::deque<Keyframe> keyframes_;  // oldest first
   Pose2D frame_;
   ReferencePoints reference_;
+  std::uint64_t revision_ = 0;
   // Scratch of rebuild(): kept points by grid cell (cell side = resolution).
   std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> cells_;
   std::vector<Eigen::Vector2d> kept_;  // in the keyframe's frame

@@ -16,6 +16,7 @@
 #include <geometry_msgs/Transform.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/Header.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -123,5 +124,12 @@ visualization_msgs::MarkerArray populationMarkers(const std_msgs::Header& header
                                                   const std::vector<hglasm::Pose2D>& population,
                                                   const hglasm::Pose2D& estimate,
                                                   const hglasm::Pose2D& guess);
+
+/// ~local_map: `points`, given in a frame whose pose in `header`'s frame is `frame` (LocalMap::frame() and
+/// reference().points), moved into `header`'s frame (its stamp too) as one unordered row of x, y, z float32
+/// fields (z = 0). Points that are not finite there are left out (the cloud is dense); none if `frame`
+/// is not finite.
+sensor_msgs::PointCloud2 pointCloudMsgFromPoints(const std_msgs::Header& header, const hglasm::Pose2D& frame,
+                                                 const std::vector<Eigen::Vector2d>& points);
 
 }  // namespace hglasm_odometry

@@ -11,6 +11,7 @@
 // unloading never waits out a timeout.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -43,8 +44,8 @@ namespace hglasm_odometry {
 class LaserOdometry {
  public:
   /// `nh` resolves the input topics (`scan`, `odom`), `private_nh` the outputs (~odom, ~pose, ~path,
-  /// ~match, ~ga_population), ~reset, ~set_pose and the set-pose topic (set_pose/topic, when enabled).
-  /// `options` must come from loadOptions() (already validated).
+  /// ~match, ~ga_population, ~local_map), ~reset, ~set_pose and the set-pose topic (set_pose/topic, when
+  /// enabled). `options` must come from loadOptions() (already validated).
   LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
                 const LaserOdometryOptions& options);
   ~LaserOdometry();
@@ -91,6 +92,10 @@ class LaserOdometry {
   /// ~odom, ~pose, tf and ~path (for a published estimate) and ~match of one scan.
   void publish(const sensor_msgs::LaserScan& msg, const hglasm::PipelineUpdate& update, double total_ms);
   void publishPose(const ros::Time& stamp, const hglasm::TrackerUpdate& update);
+  /// ~local_map, only while someone subscribes: when the local map changed since it was last sent (a
+  /// keyframe came, a reset) or a subscriber connected since (not latched: a new subscriber gets it with
+  /// the next scan). Costs nothing but getNumSubscribers() otherwise.
+  void publishLocalMap(const ros::Time& stamp);
   void publishPopulation(const ros::Time& stamp, const hglasm::TrackerUpdate& update,
                          const std::vector<hglasm::Pose2D>& population);
   /// Logs `text` as a warning unless the same `key` was logged less than `period` seconds ago.
@@ -116,6 +121,8 @@ class LaserOdometry {
   bool have_mount_ = false;
   std::string mount_frame_;
   std::deque<geometry_msgs::PoseStamped> path_;
+  bool local_map_sent_ = false;
+  std::uint64_t local_map_revision_ = 0;  // hglasm::LocalMap::revision() of the last ~local_map sent
   bool warned_odom_child_frame_ = false;
 
   // Diagnostics (guarded by stats_mutex_).
@@ -135,6 +142,9 @@ class LaserOdometry {
   std::mutex log_mutex_;
   std::map<std::string, ros::WallTime> last_warning_;
 
+  // Set by ~local_map's connect callback (a spinner thread), taken by the worker: send the map again.
+  std::atomic<bool> local_map_resend_{false};
+
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
@@ -144,6 +154,7 @@ class LaserOdometry {
   ros::Publisher path_pub_;
   ros::Publisher match_pub_;
   ros::Publisher population_pub_;
+  ros::Publisher local_map_pub_;
   ros::ServiceServer reset_service_;
   ros::ServiceServer set_pose_service_;
   ros::Subscriber set_pose_sub_;
