@@ -11,6 +11,8 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "hglasm_odometry/evaluation/gnuplot.h"
+
 namespace hglasm {
 namespace {
 
@@ -21,15 +23,6 @@ constexpr int kTitleHeight = 30;
 /// Closest grid lines and labelled tics (pixels).
 constexpr double kMinGridPixels = 4.0;
 constexpr double kMinLabelPixels = 60.0;
-
-std::string gnuplotQuote(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) {
-    quoted += c;
-    if (c == '\'') quoted += '\'';
-  }
-  return quoted + "'";
-}
 
 std::string shellQuote(const std::string& text) {
   std::string quoted = "'";

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "hglasm_odometry/evaluation/gnuplot.h"
+
 namespace hglasm {
 namespace {
 
@@ -17,15 +19,6 @@ std::string formatNumber(const char* format, double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), format, value);
   return buffer;
-}
-
-std::string gnuplotQuote(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) {
-    quoted += c;
-    if (c == '\'') quoted += '\'';
-  }
-  return quoted + "'";
 }
 
 bool writeFile(const std::string& path, const std::string& content, std::string* error) {
