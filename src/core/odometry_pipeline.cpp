@@ -47,10 +47,32 @@ bool OdometryPipeline::addOdometry(double stamp, const Pose2D& pose) {
   return true;
 }
 
-bool OdometryPipeline::odometryReadyFor(double stamp) const {
+bool OdometryPipeline::addImu(double stamp, double value) {
+  if (!tracker_.addImu(stamp, value)) return false;
+  if (stamp > newest_imu_stamp_) newest_imu_stamp_ = stamp;
+  imu_stalled_ = false;
+  return true;
+}
+
+bool OdometryPipeline::wheelsReadyFor(double stamp) const {
   if (!tracker_.options().use_odometry || !wait_for_odometry_) return true;
   if (!std::isfinite(newest_odometry_stamp_)) return true;  // none yet: nothing to wait for
   return odometry_stalled_ || newest_odometry_stamp_ >= stamp;
+}
+
+bool OdometryPipeline::imuReadyFor(double stamp) const {
+  if (!tracker_.options().use_imu || !wait_for_odometry_) return true;
+  if (!std::isfinite(newest_imu_stamp_)) return true;
+  return imu_stalled_ || newest_imu_stamp_ >= stamp;
+}
+
+bool OdometryPipeline::odometryReadyFor(double stamp) const {
+  return wheelsReadyFor(stamp) && imuReadyFor(stamp);
+}
+
+void OdometryPipeline::odometryWaitTimedOut(double stamp) {
+  if (!wheelsReadyFor(stamp)) odometry_stalled_ = true;
+  if (!imuReadyFor(stamp)) imu_stalled_ = true;
 }
 
 std::string OdometryPipeline::checkGeometry(const RangeScan& ranges) {
@@ -94,6 +116,13 @@ PipelineUpdate OdometryPipeline::processScan(double stamp, const RangeScan& rang
         base_to_laser_.inverse() * relativePose(keyframe_before, result.guess) * base_to_laser_;
   }
   if (result.new_keyframe) keyframe_pose_ = result.pose;
+  if (tracker_.options().use_imu && result.published && !result.reset) {
+    update.imu_stale = !result.imu_rotation;
+    update.imu_stale_changed = update.imu_stale != imu_stale_;
+    imu_stale_ = update.imu_stale;
+  } else {
+    update.imu_stale = imu_stale_;
+  }
   return update;
 }
 

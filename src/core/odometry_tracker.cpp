@@ -14,6 +14,9 @@ namespace {
 constexpr double kMaxVariance = kUnknownVariance;
 constexpr int kMinFitnessHistory = 20;     // matches before the usual fit is known
 constexpr double kFitnessHalfLife = 50.0;  // matches
+// Variance of the rotation between where two consecutive scans alone put the base (rad^2): two matches
+// against the same map share most of their error; (2 mrad)^2 leaves room for a keyframe change between.
+constexpr double kScanRotationVariance = 0.002 * 0.002;
 
 Eigen::Matrix3d symmetricClamped(const Eigen::Matrix3d& covariance) {
   const Eigen::Matrix3d symmetric = 0.5 * (covariance + covariance.transpose());
@@ -112,9 +115,10 @@ OdometryTracker::OdometryTracker(const TrackerOptions& options)
     : options_(options),
       matcher_(options.matcher),
       extrapolator_(options.use_odometry, options.odometry_max_extrapolation, options.max_odometry_speed,
-                    options.max_odometry_turn_rate),
+                    options.max_odometry_turn_rate, options.use_imu, options.imu),
       keyframes_(options.keyframe_distance, options.keyframe_angle, options.keyframe_min_fitness),
       noise_(options.motion),
+      gyro_bias_(options.imu),
       local_map_(options.local_map) {
   if (!matcherHasGradedTable(options_.matcher.algorithm)) {
     LookupTableOptions graded = options_.matcher.table;
@@ -141,7 +145,7 @@ void OdometryTracker::reset() {
   extrapolator_.reset();
   prediction_wrong_ = 0.0;
   fitness_ = RunningStats();
-  have_scan_only_pose_ = false;
+  have_scan_only_pose_ = have_scan_rotation_ = false;
   set_pose_stamp_.reset();
 }
 
@@ -400,7 +404,8 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   if (!update->leap) {
     learnNoise(prediction, chosen.match);
   } else {
-    have_scan_only_pose_ = false;  // the wheels were wrong beyond their noise: an outlier, not their noise
+    // The prediction was wrong beyond its noise: an outlier, not the wheels' noise or the gyro's bias.
+    have_scan_only_pose_ = have_scan_rotation_ = false;
   }
   return true;
 }
@@ -410,14 +415,21 @@ void OdometryTracker::learnNoise(const MotionPrediction& prediction, const Match
   // where the scans alone put them is a far better measurement of the increment than any wheels': what
   // the wheels' increment differs from it by is (almost all) their noise.
   const Pose2D scan_only = fromMap(match.scan_only_pose);
-  const bool usable =
-      prediction.source == PredictionSource::kOdometry && !match.degenerate && scan_only.isFinite();
+  const bool scan_usable = !match.degenerate && scan_only.isFinite();
+  const bool usable = prediction.source == PredictionSource::kOdometry && scan_usable;
   if (usable && have_scan_only_pose_) {
     const Pose2D wheel_error = relativePose(prediction.motion, relativePose(scan_only_pose_, scan_only));
     noise_.learn(Eigen::Vector3d(wheel_error.x, wheel_error.y, wheel_error.theta), Eigen::Vector3d::Zero(),
                  prediction.nominal_covariance.diagonal());
   }
+  if (prediction.gyro && scan_usable && have_scan_rotation_) {
+    const double scan_rotation = normalizeAngle(scan_only.theta - scan_only_pose_.theta);
+    if (gyro_bias_.update(prediction.motion.theta, scan_rotation, kScanRotationVariance, prediction.dt)) {
+      extrapolator_.setGyroBias(gyro_bias_.bias(), gyro_bias_.variance());
+    }
+  }
   have_scan_only_pose_ = usable;
+  have_scan_rotation_ = scan_usable;
   scan_only_pose_ = scan_only;
 }
 
@@ -541,6 +553,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   const MotionPrediction prediction = extrapolator_.predict(last_stamp_, stamp, noise_, &prediction_warning);
   if (update.warning.empty()) update.warning = prediction_warning;
   update.prediction = prediction.source;
+  update.imu_rotation = prediction.gyro;
   update.guess = pose_ * prediction.motion;
 
   Estimate estimate;
@@ -553,7 +566,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
     update.match.status = local_map_.empty() ? MatchStatus::kNoReference : MatchStatus::kTooFewPoints;
   }
   if (!matched) {
-    have_scan_only_pose_ = false;
+    have_scan_only_pose_ = have_scan_rotation_ = false;
     update.fallback = true;  // nothing (convincing) to match: keep the motion predicted
     estimate = integratePrediction(prediction);
     if (usable) update.fitness_ratio = fitnessRatioAt(scan, estimate.laser_in_map);
@@ -581,6 +594,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   update.velocity = extrapolator_.velocity();
   update.keyframe_id = keyframe_id_;
   update.noise_scale = noise_.scale();
+  update.imu_bias = gyro_bias_.bias();
   return update;
 }
 

@@ -19,14 +19,43 @@ const char* toString(PredictionSource source) {
 }
 
 PoseExtrapolator::PoseExtrapolator(bool use_odometry, double max_odometry_age, double max_speed,
-                                   double max_turn_rate)
+                                   double max_turn_rate, bool use_gyro, const GyroOptions& gyro)
     : use_odometry_(use_odometry),
       max_odometry_age_(max_odometry_age),
       max_speed_(max_speed),
-      max_turn_rate_(max_turn_rate) {}
+      max_turn_rate_(max_turn_rate),
+      use_gyro_(use_gyro),
+      gyro_(gyro),
+      gyro_bias_variance_(gyro.bias * gyro.bias) {}
 
 MotionPrediction PoseExtrapolator::predict(double from, double to, const MotionNoiseModel& noise,
                                            std::string* warning) const {
+  MotionPrediction prediction = predictTranslation(from, to, noise, warning);
+  prediction.dt = to - from;
+  if (use_gyro_) applyGyro(from, to, &prediction);
+  return prediction;
+}
+
+void PoseExtrapolator::applyGyro(double from, double to, MotionPrediction* prediction) const {
+  double raw_angle = 0.0;
+  if (!gyro_.rotation(from, to, &raw_angle)) return;
+  const double angle = raw_angle - gyro_bias_ * (to - from);
+  // Along an arc the chord turns by half the rotation: with the rotation corrected, so is the chord.
+  const double correction = 0.5 * (angle - prediction->motion.theta);
+  const double c = std::cos(correction), s = std::sin(correction);
+  const Pose2D& motion = prediction->motion;
+  prediction->motion = Pose2D(c * motion.x - s * motion.y, s * motion.x + c * motion.y, angle);
+  // The heading's noise is the IMU's alone, independent of the translation's.
+  for (Eigen::Matrix3d* covariance : {&prediction->covariance, &prediction->nominal_covariance}) {
+    covariance->row(2).setZero();
+    covariance->col(2).setZero();
+  }
+  prediction->covariance(2, 2) = gyroRotationVariance(gyro_.options(), angle, to - from, gyro_bias_variance_);
+  prediction->gyro = true;
+}
+
+MotionPrediction PoseExtrapolator::predictTranslation(double from, double to, const MotionNoiseModel& noise,
+                                                      std::string* warning) const {
   MotionPrediction prediction;
   const double dt = to - from;
   Pose2D odom_from, odom_to;

@@ -1,5 +1,6 @@
 #include "hglasm_odometry/ros/conversions.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -37,6 +38,8 @@ visualization_msgs::Marker arrowMarker(const std_msgs::Header& header, int id, c
 /// Match's fields that say what happened to the scan and how it was searched.
 void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
   match->prediction_source = toMsg(update.prediction);
+  match->imu_rotation = update.imu_rotation;
+  match->imu_bias = finiteFloat(update.imu_bias);
   match->status = toMsg(update.match.status);
   match->status_text = hglasm::toString(update.match.status);
   match->jump_rejected = update.jump_rejected;
@@ -114,6 +117,55 @@ bool laserMountFromTransform(const geometry_msgs::Transform& transform, LaserMou
   mount->base_to_laser = hglasm::Pose2D(t.x, t.y, std::atan2(sin_part, cos_part));
   mount->upside_down = upside_down;
   mount->tilt = std::acos(std::min(1.0, std::abs(r22)));
+  return true;
+}
+
+namespace {
+
+/// A normalised Eigen quaternion; false for a non-finite or (nearly) zero-length one.
+bool toUnitQuaternion(const geometry_msgs::Quaternion& q, Eigen::Quaterniond* out) {
+  const Eigen::Quaterniond quaternion(q.w, q.x, q.y, q.z);
+  const double norm = quaternion.norm();
+  if (!std::isfinite(norm) || norm < 1e-6) return false;
+  *out = quaternion.normalized();
+  return true;
+}
+
+}  // namespace
+
+bool imuValueFromMsg(const sensor_msgs::Imu& msg, const geometry_msgs::Quaternion& base_from_imu,
+                     bool use_orientation, double* value, std::string* error) {
+  Eigen::Quaterniond mount;
+  if (!toUnitQuaternion(base_from_imu, &mount)) {
+    *error = "the transform base_frame -> IMU frame has no valid rotation";
+    return false;
+  }
+  if (use_orientation) {
+    if (msg.orientation_covariance[0] == -1.0) {
+      *error =
+          "the IMU publishes no orientation (orientation_covariance[0] = -1); set imu/use_orientation false";
+      return false;
+    }
+    Eigen::Quaterniond orientation;
+    if (!toUnitQuaternion(msg.orientation, &orientation)) {
+      *error = "the IMU's orientation is not finite or has zero length";
+      return false;
+    }
+    const Eigen::Quaterniond base = orientation * mount.inverse();  // the base's rotation in the world
+    *value = std::atan2(2.0 * (base.w() * base.z() + base.x() * base.y()),
+                        1.0 - 2.0 * (base.y() * base.y() + base.z() * base.z()));
+    return true;
+  }
+  if (msg.angular_velocity_covariance[0] == -1.0) {
+    *error = "the IMU publishes no angular velocity (angular_velocity_covariance[0] = -1)";
+    return false;
+  }
+  const Eigen::Vector3d rate(msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z);
+  if (!rate.allFinite()) {
+    *error = "the IMU's angular velocity is not finite";
+    return false;
+  }
+  *value = (mount * rate).z();
   return true;
 }
 

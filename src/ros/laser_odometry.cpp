@@ -34,6 +34,8 @@ constexpr int kScanSubscriberQueue = 50;
 constexpr int kOdomSubscriberQueue = 200;
 constexpr double kTfRetrySeconds = 0.05;  // wall time between tf lookups while waiting for base -> laser
 constexpr std::size_t kMaxQueuedOdometry = 10000;  // samples kept while the worker waits (100 s at 100 Hz)
+constexpr int kImuSubscriberQueue = 1000;
+constexpr std::size_t kMaxQueuedImu = 20000;  // 20 s at 1 kHz
 
 }  // namespace
 
@@ -73,6 +75,10 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
     odom_sub_ = nh_.subscribe("odom", kOdomSubscriberQueue, &LaserOdometry::odomCallback, this,
                               ros::TransportHints().tcpNoDelay());
   }
+  if (options_.tracker.use_imu) {
+    imu_sub_ = nh_.subscribe("imu", kImuSubscriberQueue, &LaserOdometry::imuCallback, this,
+                             ros::TransportHints().tcpNoDelay());
+  }
   if (options_.set_pose.topic_enabled) {
     set_pose_sub_ =
         private_nh_.subscribe(options_.set_pose.topic, 5, &LaserOdometry::setPoseTopicCallback, this);
@@ -81,12 +87,14 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
   ROS_INFO_STREAM("[" << name_ << "] laser odometry on " << scan_sub_.getTopic()
                       << (options_.tracker.use_odometry ? " + " + odom_sub_.getTopic()
                                                         : std::string(" (no wheel odometry)"))
-                      << ": " << summarize(options_));
+                      << (options_.tracker.use_imu ? " + " + imu_sub_.getTopic() : std::string()) << ": "
+                      << summarize(options_));
 }
 
 LaserOdometry::~LaserOdometry() {
   scan_sub_.shutdown();
   odom_sub_.shutdown();
+  imu_sub_.shutdown();
   set_pose_sub_.shutdown();
   reset_service_.shutdown();
   set_pose_service_.shutdown();
@@ -127,6 +135,15 @@ void LaserOdometry::odomCallback(const nav_msgs::OdometryConstPtr& msg) {
     // The worker takes the samples before every scan; this bound only matters while it waits for tf.
     if (odometry_.size() >= kMaxQueuedOdometry) odometry_.pop_front();
     odometry_.push_back(std::move(sample));
+  }
+  input_cv_.notify_all();
+}
+
+void LaserOdometry::imuCallback(const sensor_msgs::ImuConstPtr& msg) {
+  {
+    std::lock_guard<std::mutex> lock(input_mutex_);
+    if (imu_.size() >= kMaxQueuedImu) imu_.pop_front();
+    imu_.push_back(msg);
   }
   input_cv_.notify_all();
 }
@@ -207,6 +224,55 @@ void LaserOdometry::takeQueuedInputs() {
     pipeline_.addOdometry(sample.stamp, sample.pose);
   }
   odometry_.clear();
+  for (const sensor_msgs::ImuConstPtr& msg : imu_) addImu(*msg);
+  imu_.clear();
+}
+
+void LaserOdometry::addImu(const sensor_msgs::Imu& msg) {
+  const std::string frame = stripLeadingSlash(msg.header.frame_id);
+  auto mount = imu_mounts_.find(frame);
+  if (mount == imu_mounts_.end()) {
+    geometry_msgs::Quaternion rotation;
+    rotation.w = 1.0;  // an IMU without a frame_id, or in base_frame itself
+    if (!frame.empty() && frame != options_.base_frame) {
+      try {
+        rotation = tf_buffer_.lookupTransform(options_.base_frame, frame, ros::Time(0)).transform.rotation;
+      } catch (const tf2::TransformException& ex) {
+        warnThrottled("imu_tf",
+                      "IMU samples dropped: no transform " + options_.base_frame + " -> " + frame +
+                          " (base_frame -> the IMU's frame_id) on tf yet (" + ex.what() + ")",
+                      options_.tf_warn_period);
+        return;
+      }
+    }
+    mount = imu_mounts_.emplace(frame, rotation).first;
+  }
+  double value = 0.0;
+  std::string error;
+  if (!imuValueFromMsg(msg, mount->second, options_.tracker.imu.use_orientation, &value, &error)) {
+    warnThrottled("imu_bad", "IMU sample on " + imu_sub_.getTopic() + " ignored: " + error, 10.0);
+    return;
+  }
+  pipeline_.addImu(msg.header.stamp.toSec(), value);
+}
+
+void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
+  if (!update.imu_stale_changed) return;
+  if (update.imu_stale) {
+    std::ostringstream text;
+    text << "no IMU data on " << imu_sub_.getTopic() << " covers the step to the scan at "
+         << update.tracker.stamp << " s (missing, or a gap longer than imu/max_gap "
+         << options_.tracker.imu.max_gap << " s); the rotation is predicted from "
+         << (update.tracker.prediction == hglasm::PredictionSource::kOdometry ? "the wheel odometry"
+                                                                              : "the recent motion")
+         << " until it returns";
+    ROS_WARN_STREAM("[" << name_ << "] " << text.str());
+  } else {
+    ROS_INFO_STREAM("[" << name_ << "] IMU data on " << imu_sub_.getTopic()
+                        << " again: the rotation is the IMU's");
+  }
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  imu_stale_ = update.imu_stale;
 }
 
 bool LaserOdometry::waitForOdometry(double stamp) {
@@ -221,7 +287,7 @@ bool LaserOdometry::waitForOdometry(double stamp) {
     if (input_cv_.wait_until(lock, deadline) == std::cv_status::timeout) {
       takeQueuedInputs();
       // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
-      if (!pipeline_.odometryReadyFor(stamp)) pipeline_.odometryWaitTimedOut();
+      pipeline_.odometryWaitTimedOut(stamp);
       return !stop_;
     }
   }
@@ -343,6 +409,7 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
   }
   if (!result.geometry_warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << result.geometry_warning);
   if (!update.warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << update.warning);
+  reportImuState(result);
   if (update.reset) path_.clear();
 
   publish(msg, result, msSince(start));
@@ -472,6 +539,7 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("dropped scans", dropped_total);
   status.add("queued scans", queued);
   status.add("preset", options_.preset);
+  if (options_.tracker.use_imu) status.add("IMU", imu_stale_ ? "stale: rotation from the wheels" : "in use");
 
   const bool scans_arriving =
       !last_scan_time_.isZero() && (now - last_scan_time_).toSec() <= options_.diagnostics.window;
@@ -486,6 +554,8 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   } else if (matched > 0 && failure_ratio >= options_.diagnostics.warn_failure_ratio) {
     status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%.0f%% of scans failed to match",
                     100.0 * failure_ratio);
+  } else if (options_.tracker.use_imu && imu_stale_) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "IMU stale or missing: rotation from the wheels");
   } else if (dropped_total > last_reported_drops_) {
     status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
                     "dropping scans: %u dropped so far (processing is slower than the input)", dropped_total);

@@ -275,6 +275,7 @@ void visitNodeOptions(Params& tree, LaserOdometryOptions* options) {
   tree.frame("base_frame", &options->base_frame);
   tree.boolean("publish_tf", &options->publish_tf);
   tree.boolean("use_odom", &options->tracker.use_odometry);
+  tree.boolean("use_imu", &options->tracker.use_imu);
   tree.integer("path_length", &options->path_length, 0, 1000000);
   tree.integer("queue_size", &options->queue_size, 1, 10000);
   tree.boolean("publish_population", &options->publish_population);
@@ -334,6 +335,14 @@ void visitPredictionOptions(Params& tree, LaserOdometryOptions* options) {
   tree.positiveNumber("odometry/max_speed", &tracker.max_odometry_speed);
   tree.positiveNumber("odometry/max_turn_rate", &tracker.max_odometry_turn_rate);
   tree.number("odometry/wait", &options->odometry_wait, 0.0, 10.0);
+  hglasm::GyroOptions& imu = tracker.imu;
+  tree.boolean("imu/use_orientation", &imu.use_orientation);
+  tree.number("imu/max_gap", &imu.max_gap, 0.0, 10.0, true);
+  tree.nonNegativeNumber("imu/noise/angle_random_walk", &imu.angle_random_walk);
+  tree.nonNegativeNumber("imu/noise/bias", &imu.bias);
+  tree.nonNegativeNumber("imu/noise/scale_error", &imu.scale_error);
+  tree.boolean("imu/noise/estimate_bias", &imu.estimate_bias);
+  tree.nonNegativeNumber("imu/noise/bias_random_walk", &imu.bias_random_walk);
 }
 
 /// Scan conversion.
@@ -586,8 +595,11 @@ std::string summarize(const LaserOdometryOptions& options) {
       << matcher.table.cell_size << " m, keyframe " << options.tracker.keyframe_distance << " m / "
       << options.tracker.keyframe_angle << " rad, " << options.odom_frame << " -> " << options.base_frame
       << (options.publish_tf ? " (tf)" : " (no tf)")
-      << (options.tracker.use_odometry ? ", wheel odometry in" : ", no wheel odometry") << ", queue "
-      << options.queue_size;
+      << (options.tracker.use_odometry ? ", wheel odometry in" : ", no wheel odometry")
+      << (options.tracker.use_imu
+              ? (options.tracker.imu.use_orientation ? ", IMU orientation in" : ", IMU rate in")
+              : "")
+      << ", queue " << options.queue_size;
   return out.str();
 }
 

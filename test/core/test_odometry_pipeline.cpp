@@ -53,7 +53,7 @@ TEST(OdometryPipeline, WaitsForOdometryAtOrAfterTheScan) {
   EXPECT_TRUE(pipeline.odometryReadyFor(1.0)) << "a sample at the scan's stamp";
   EXPECT_FALSE(pipeline.odometryReadyFor(1.05));
   EXPECT_FALSE(pipeline.odometryReadyFor(5.0)) << "old odometry is waited for: a gap in the data, not a stop";
-  pipeline.odometryWaitTimedOut();
+  pipeline.odometryWaitTimedOut(5.0);
   EXPECT_TRUE(pipeline.odometryStalled());
   EXPECT_TRUE(pipeline.odometryReadyFor(5.0)) << "after a wait timed out, odometry counts as stalled";
   EXPECT_FALSE(pipeline.addOdometry(std::nan(""), Pose2D()));
@@ -76,6 +76,28 @@ TEST(OdometryPipeline, NeverWaitsWhenOdometryIsOffOrWaitingDisabled) {
   OdometryPipeline no_wait(TrackerOptions(), false);
   no_wait.addOdometry(0.9, Pose2D());
   EXPECT_TRUE(no_wait.odometryReadyFor(1.0));
+}
+
+TEST(OdometryPipeline, WithUseImuTheImuIsWaitedForAndStallsOnItsOwn) {
+  TrackerOptions options;
+  options.use_imu = true;
+  OdometryPipeline pipeline(options);
+  ASSERT_TRUE(pipeline.addOdometry(1.0, Pose2D()));
+  EXPECT_TRUE(pipeline.odometryReadyFor(1.0)) << "no IMU sample yet: nothing to wait for";
+  ASSERT_TRUE(pipeline.addImu(0.95, 0.0));
+  EXPECT_FALSE(pipeline.odometryReadyFor(1.0)) << "the wheels are there, the IMU's sample is still to come";
+  ASSERT_TRUE(pipeline.addImu(1.0, 0.0));
+  EXPECT_TRUE(pipeline.odometryReadyFor(1.0));
+  ASSERT_TRUE(pipeline.addOdometry(2.0, Pose2D()));
+  pipeline.odometryWaitTimedOut(2.0);
+  EXPECT_TRUE(pipeline.imuStalled());
+  EXPECT_FALSE(pipeline.odometryStalled()) << "the wheels had their sample";
+  EXPECT_TRUE(pipeline.odometryReadyFor(2.0));
+  EXPECT_FALSE(pipeline.addImu(std::nan(""), 0.0));
+  EXPECT_TRUE(pipeline.imuStalled()) << "a rejected sample does not revive it";
+  ASSERT_TRUE(pipeline.addImu(1.5, 0.0));
+  EXPECT_FALSE(pipeline.imuStalled());
+  EXPECT_FALSE(pipeline.odometryReadyFor(2.0));
 }
 
 TEST(OdometryPipeline, ReplayAddsWhatTheLiveNodeHoldsAfterItsWait) {
@@ -139,6 +161,41 @@ TEST(OdometryPipeline, ScanErrorChangesAreReportedOnce) {
     changed.push_back(update.scan_error_changed);
   }
   EXPECT_EQ(changed, std::vector<bool>({false, true, false, true, false}));
+}
+
+TEST(OdometryPipeline, ImuStalenessChangesAreReportedOnce) {
+  TrackerOptions options;
+  options.use_odometry = false;
+  options.use_imu = true;
+  OdometryPipeline pipeline(options);
+  const hglasm::RangeScan scan = rangesAt(Pose2D(), false);
+  // The IMU covers 0.1-0.32 s and 0.58-0.8 s at 200 Hz; scans every 0.1 s from 0.1 s (the first starts the
+  // odometry).
+  for (int i = 20; i <= 64; ++i) ASSERT_TRUE(pipeline.addImu(0.005 * i, 0.0));
+  for (int i = 116; i <= 160; ++i) ASSERT_TRUE(pipeline.addImu(0.005 * i, 0.0));
+  EXPECT_FALSE(pipeline.addImu(std::nan(""), 0.0));
+  std::vector<bool> stale, changed;
+  for (int i = 1; i <= 8; ++i) {
+    const PipelineUpdate update = pipeline.processScan(0.1 * i, scan);
+    stale.push_back(update.imu_stale);
+    changed.push_back(update.imu_stale_changed);
+  }
+  // 0.1: the start; 0.2, 0.3: covered; 0.4 (0.08 s past the last sample is within max_gap); 0.5, 0.6: the
+  // 0.32-0.58 gap; 0.7, 0.8: covered again.
+  EXPECT_EQ(stale, std::vector<bool>({false, false, false, true, true, true, false, false}));
+  EXPECT_EQ(changed, std::vector<bool>({false, false, false, true, false, false, true, false}));
+}
+
+TEST(OdometryPipeline, WithoutUseImuNothingIsStale) {
+  OdometryPipeline pipeline;
+  EXPECT_FALSE(pipeline.addImu(0.0, 1.0));
+  const hglasm::RangeScan scan = rangesAt(Pose2D(), false);
+  for (int i = 1; i <= 3; ++i) {
+    const PipelineUpdate update = pipeline.processScan(0.1 * i, scan);
+    EXPECT_FALSE(update.imu_stale);
+    EXPECT_FALSE(update.imu_stale_changed);
+    EXPECT_FALSE(update.tracker.imu_rotation);
+  }
 }
 
 /// An upside-down laser mounted off-centre and turned: tracked only if the pipeline mirrors its scans, and

@@ -116,6 +116,78 @@ TEST(PoseExtrapolator, OdometryIgnoredWhenDisabledStaleOrCleared) {
   EXPECT_TRUE(warning.empty());
 }
 
+PoseExtrapolator makeGyroExtrapolator(bool use_odometry = true) {
+  hglasm::GyroOptions gyro;
+  gyro.angle_random_walk = 0.01;
+  gyro.bias = 0.02;
+  gyro.scale_error = 0.03;
+  return PoseExtrapolator(use_odometry, kOdometryAge, kMaxSpeed, kMaxTurnRate, true, gyro);
+}
+
+TEST(PoseExtrapolator, TheGyroGivesTheRotationAndTurnsTheWheelsChordWithIt) {
+  PoseExtrapolator extrapolator = makeGyroExtrapolator();
+  // The wheels: 1 m straight ahead, no turn. The gyro: 0.8 rad/s for 0.5 s, 0.4 rad. The chord of the arc
+  // turns by half the rotation: (cos 0.2, sin 0.2).
+  extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addOdometry(0.5, Pose2D(1.0, 0.0, 0.0));
+  for (int i = 0; i <= 50; ++i) EXPECT_TRUE(extrapolator.addGyro(0.01 * i, 0.8));
+  const MotionNoiseModel noise;
+  std::string warning;
+  const MotionPrediction prediction = extrapolator.predict(0.0, 0.5, noise, &warning);
+  EXPECT_EQ(prediction.source, PredictionSource::kOdometry);
+  EXPECT_TRUE(prediction.gyro);
+  expectPose(prediction.motion, std::cos(0.2), std::sin(0.2), 0.4);
+  // Translation noise: the wheels'; heading noise: the gyro's alone, uncorrelated with it; the wheels'
+  // nominal heading variance is zero (their heading is not what was predicted, so not learned from).
+  const Eigen::Matrix3d wheels = noise.odometryCovariance(Pose2D(1.0, 0.0, 0.0), 0.5);
+  const Eigen::Matrix2d translation = prediction.covariance.topLeftCorner<2, 2>();
+  EXPECT_EQ(translation, (wheels.topLeftCorner<2, 2>()));
+  EXPECT_NEAR(prediction.covariance(2, 2), 0.01 * 0.01 * 0.5 + 0.01 * 0.01 + 0.012 * 0.012, 1e-15);
+  EXPECT_EQ(prediction.covariance(0, 2), 0.0);
+  EXPECT_EQ(prediction.covariance(2, 1), 0.0);
+  EXPECT_EQ(prediction.nominal_covariance(2, 2), 0.0);
+  EXPECT_GT(prediction.nominal_covariance(0, 0), 0.0);
+}
+
+TEST(PoseExtrapolator, WithoutWheelsTheGyroTurnsTheConstantVelocityPrediction) {
+  PoseExtrapolator extrapolator = makeGyroExtrapolator(false);
+  extrapolator.addPose(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addPose(0.5, Pose2D(0.5, 0.0, 0.0));  // 1 m/s straight
+  for (int i = 0; i <= 100; ++i) extrapolator.addGyro(0.01 * i, -1.0);
+  std::string warning;
+  const MotionPrediction prediction = extrapolator.predict(0.5, 0.7, MotionNoiseModel(), &warning);
+  EXPECT_EQ(prediction.source, PredictionSource::kConstantVelocity);
+  EXPECT_TRUE(prediction.gyro);
+  expectPose(prediction.motion, 0.2 * std::cos(-0.1), 0.2 * std::sin(-0.1), -0.2);
+}
+
+TEST(PoseExtrapolator, StaleOrMissingGyroLeavesTheWheelsPrediction) {
+  PoseExtrapolator extrapolator = makeGyroExtrapolator();
+  extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addOdometry(1.0, Pose2D(1.0, 0.0, 0.3));
+  const MotionNoiseModel noise;
+  std::string warning;
+  const MotionPrediction missing = extrapolator.predict(0.0, 1.0, noise, &warning);
+  EXPECT_FALSE(missing.gyro);
+  expectPose(missing.motion, 1.0, 0.0, 0.3);
+  EXPECT_EQ(missing.covariance, noise.odometryCovariance(missing.motion, 1.0));
+  for (int i = 0; i <= 50; ++i) extrapolator.addGyro(0.01 * i, 2.0);  // stops at 0.5 s
+  const MotionPrediction stale = extrapolator.predict(0.0, 1.0, noise, &warning);
+  EXPECT_FALSE(stale.gyro);
+  expectPose(stale.motion, 1.0, 0.0, 0.3);
+  EXPECT_TRUE(extrapolator.predict(0.0, 0.55, noise, &warning).gyro) << "within max_gap of the newest sample";
+  extrapolator.clearOdometry();
+  EXPECT_FALSE(extrapolator.predict(0.0, 0.5, noise, &warning).gyro) << "cleared with the odometry";
+}
+
+TEST(PoseExtrapolator, GyroSamplesAreIgnoredWithoutUseGyro) {
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  EXPECT_FALSE(extrapolator.addGyro(0.0, 1.0));
+  EXPECT_FALSE(extrapolator.addGyro(0.1, 1.0));
+  std::string warning;
+  EXPECT_FALSE(extrapolator.predict(0.0, 0.1, MotionNoiseModel(), &warning).gyro);
+}
+
 TEST(PoseExtrapolator, VelocityNeedsABaselineOfATenthOfASecond) {
   PoseExtrapolator extrapolator = makeExtrapolator();
   // 1.5 m/s along x; stamps and positions exact in binary.

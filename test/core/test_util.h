@@ -7,9 +7,11 @@
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -126,6 +128,29 @@ inline double castRay(const World& world, const Eigen::Vector2d& origin, const E
     if (t > 1e-9 && u >= 0.0 && u <= 1.0 && t < best) best = t;
   }
   return best;
+}
+
+// ------------------------------------------------------------------ paths
+
+/// A 1.5 m square driven at 0.5 m/s, turning left on the spot at each corner at `turn_rate` rad/s
+/// (constant, from standstill to standstill), from the identity pose; it stays clear of the room's boxes.
+inline std::function<hglasm::Pose2D(double)> squareWithSpins(double turn_rate) {
+  constexpr double kSide = 1.5, kSpeed = 0.5;
+  const double drive_time = kSide / kSpeed, turn_time = (kPi / 2) / turn_rate;
+  return [=](double t) {
+    const double leg = drive_time + turn_time;
+    const double lap = std::fmod(std::max(t, 0.0), 4.0 * leg);
+    const int side = static_cast<int>(lap / leg);
+    const double within = lap - side * leg;
+    const Eigen::Vector2d corners[4] = {{0.0, 0.0}, {kSide, 0.0}, {kSide, kSide}, {0.0, kSide}};
+    const Eigen::Vector2d start = corners[side], end = corners[(side + 1) % 4];
+    const double heading = side * kPi / 2;
+    if (within < drive_time) {
+      const Eigen::Vector2d at = start + (end - start) * (within / drive_time);
+      return rawPose(at.x(), at.y(), angleDiff(heading, 0.0));
+    }
+    return rawPose(end.x(), end.y(), angleDiff(heading + turn_rate * (within - drive_time), 0.0));
+  };
 }
 
 // ------------------------------------------------------------------ the simulated laser

@@ -1,6 +1,8 @@
 // Message conversions: REP-117 ranges, descending and 360-degree scans, upside-down mounts, covariance.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <limits>
 
@@ -263,6 +265,78 @@ TEST(PoseConversions, OdometryMessageGivesThePlanarPose) {
   EXPECT_NEAR(pose.theta, 0.5, 1e-12);
   odom.pose.pose.orientation.z = kInf;
   EXPECT_FALSE(pose2DFromOdometryMsg(odom, &pose));
+}
+
+/// Rotation about the unit axis (x, y, z) by `angle`.
+geometry_msgs::Quaternion axisAngle(double x, double y, double z, double angle) {
+  geometry_msgs::Quaternion q;
+  q.w = std::cos(angle / 2);
+  q.x = x * std::sin(angle / 2);
+  q.y = y * std::sin(angle / 2);
+  q.z = z * std::sin(angle / 2);
+  return q;
+}
+
+TEST(ImuConversion, TheRateIsRotatedIntoTheBaseFrame) {
+  sensor_msgs::Imu imu;
+  imu.angular_velocity.x = 0.1;
+  imu.angular_velocity.y = 0.2;
+  imu.angular_velocity.z = 0.7;
+  double rate = 0.0;
+  std::string error;
+  ASSERT_TRUE(imuValueFromMsg(imu, quaternionFromYaw(1.0), false, &rate, &error)) << error;
+  EXPECT_NEAR(rate, 0.7, 1e-12) << "a yawed mount leaves the yaw rate";
+  // Upside down (rolled by pi about x): the IMU's z points down, so its rate is the base's negated.
+  ASSERT_TRUE(imuValueFromMsg(imu, axisAngle(1, 0, 0, M_PI), false, &rate, &error));
+  EXPECT_NEAR(rate, -0.7, 1e-12);
+  // Mounted on its side (pitched by -pi/2 about y: its x axis points up): the base's yaw rate is its x.
+  ASSERT_TRUE(imuValueFromMsg(imu, axisAngle(0, 1, 0, -M_PI / 2), false, &rate, &error));
+  EXPECT_NEAR(rate, 0.1, 1e-12);
+}
+
+TEST(ImuConversion, TheOrientationGivesTheBaseYaw) {
+  sensor_msgs::Imu imu;
+  double yaw = 0.0;
+  std::string error;
+  imu.orientation = quaternionFromYaw(2.5);
+  // An IMU yawed by 0.5 rad on the base: the base's yaw is 2.0.
+  ASSERT_TRUE(imuValueFromMsg(imu, quaternionFromYaw(0.5), true, &yaw, &error)) << error;
+  EXPECT_NEAR(yaw, 2.0, 1e-12);
+  // Upside down: the IMU's orientation is the base's rolled by pi; the base's yaw comes back.
+  Eigen::Quaterniond base(Eigen::AngleAxisd(-1.2, Eigen::Vector3d::UnitZ()));
+  const Eigen::Quaterniond mount(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
+  const Eigen::Quaterniond sensor = base * mount;
+  imu.orientation.w = sensor.w();
+  imu.orientation.x = sensor.x();
+  imu.orientation.y = sensor.y();
+  imu.orientation.z = sensor.z();
+  ASSERT_TRUE(imuValueFromMsg(imu, axisAngle(1, 0, 0, M_PI), true, &yaw, &error));
+  EXPECT_NEAR(yaw, -1.2, 1e-12);
+}
+
+TEST(ImuConversion, MissingAndNonFiniteDataAreRefusedWithAReason) {
+  sensor_msgs::Imu imu;
+  double value = 0.0;
+  std::string error;
+  imu.angular_velocity_covariance[0] = -1.0;
+  EXPECT_FALSE(imuValueFromMsg(imu, quaternionFromYaw(0.0), false, &value, &error));
+  EXPECT_NE(error.find("no angular velocity"), std::string::npos) << error;
+  imu.angular_velocity_covariance[0] = 0.0;
+  imu.angular_velocity.z = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(imuValueFromMsg(imu, quaternionFromYaw(0.0), false, &value, &error));
+  EXPECT_NE(error.find("not finite"), std::string::npos) << error;
+  imu.orientation_covariance[0] = -1.0;
+  EXPECT_FALSE(imuValueFromMsg(imu, quaternionFromYaw(0.0), true, &value, &error));
+  EXPECT_NE(error.find("imu/use_orientation false"), std::string::npos) << error;
+  imu.orientation_covariance[0] = 0.0;
+  imu.orientation = geometry_msgs::Quaternion();
+  imu.orientation.w = 0.0;
+  EXPECT_FALSE(imuValueFromMsg(imu, quaternionFromYaw(0.0), true, &value, &error));
+  geometry_msgs::Quaternion zero;
+  zero.w = 0.0;
+  imu.angular_velocity.z = 0.5;
+  EXPECT_FALSE(imuValueFromMsg(imu, zero, false, &value, &error));
+  EXPECT_NE(error.find("transform"), std::string::npos) << error;
 }
 
 TEST(Covariance, PlanarBlockLandsOnXYYawAndUnobservedDimensionsAreLargeButFinite) {

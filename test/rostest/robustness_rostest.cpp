@@ -20,319 +20,22 @@
 //       manager's memory does not grow.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <cmath>
-#include <fstream>
-#include <functional>
-#include <memory>
-#include <mutex>
-#include <sstream>
-#include <string>
-#include <vector>
-
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <dirent.h>
-#include <geometry_msgs/PoseWithCovarianceStamped.h>
-#include <nav_msgs/Odometry.h>
+
+#include <fstream>
+#include <memory>
+
 #include <nodelet/NodeletLoad.h>
 #include <nodelet/NodeletUnload.h>
-#include <ros/ros.h>
-#include <rosgraph_msgs/Log.h>
-#include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
-#include <tf2_msgs/TFMessage.h>
-#include <tf2_ros/static_transform_broadcaster.h>
 
-#include "../core/test_expect.h"
-#include "../core/test_util.h"
-#include "hglasm_odometry/Match.h"
 #include "hglasm_odometry/SetPose.h"
-#include "hglasm_odometry/ros/conversions.h"
+#include "simulated_robot.h"
 
 namespace hglasm_odometry {
 namespace {
 
-using hglasm::Pose2D;
-using hglasm_test::deg;
-using hglasm_test::LaserSpec;
-using Path = std::function<Pose2D(double)>;
-
-constexpr double kStampOrigin = 1000.0;  // scan stamps are kStampOrigin + simulated time (no sim time)
-
-bool finite(const boost::array<double, 36>& values) {
-  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
-}
-bool finite(const geometry_msgs::Pose& p) {
-  return std::isfinite(p.position.x) && std::isfinite(p.position.y) && std::isfinite(p.position.z) &&
-         std::isfinite(p.orientation.x) && std::isfinite(p.orientation.y) && std::isfinite(p.orientation.z) &&
-         std::isfinite(p.orientation.w);
-}
-bool finite(const geometry_msgs::Pose2D& p) {
-  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.theta);
-}
-
-Pose2D pose2D(const geometry_msgs::Pose& pose) {
-  Pose2D out;
-  pose2DFromPoseMsg(pose, &out);
-  return out;
-}
-
-std::string describe(const Match& m) {
-  std::ostringstream text;
-  text << "match @" << m.header.stamp << ": status " << m.status_text << " matched " << int(m.matched)
-       << " fallback " << int(m.fallback) << " keyframe " << int(m.new_keyframe) << " reset " << int(m.reset)
-       << " prediction " << int(m.prediction_source) << " fitness " << m.fitness_ratio << " valid "
-       << m.valid_points << " invalid " << m.invalid_points << " dropped " << m.dropped_scans;
-  return text.str();
-}
-
-// ------------------------------------------------------------------ what the nodelets publish
-
-/// Everything on /rosout, /diagnostics and /tf (filtered per instance when read).
-struct Recorder {
-  std::mutex mutex;
-  std::vector<rosgraph_msgs::Log> logs;
-  std::vector<diagnostic_msgs::DiagnosticStatus> diagnostics_all;
-  std::vector<geometry_msgs::TransformStamped> transforms;
-
-  void onLog(const rosgraph_msgs::LogConstPtr& msg) {
-    std::lock_guard<std::mutex> lock(mutex);
-    logs.push_back(*msg);
-  }
-  void onDiagnostics(const diagnostic_msgs::DiagnosticArrayConstPtr& msg) {
-    std::lock_guard<std::mutex> lock(mutex);
-    for (const auto& status : msg->status) diagnostics_all.push_back(status);
-  }
-  void onTf(const tf2_msgs::TFMessageConstPtr& msg) {
-    std::lock_guard<std::mutex> lock(mutex);
-    for (const auto& t : msg->transforms) transforms.push_back(t);
-  }
-
-  /// Log lines of `instance` ("/odo_a"; "" = any) at `level` (rosgraph_msgs::Log::WARN, ...), from index
-  /// `from` on.
-  std::vector<std::string> lines(const std::string& instance, std::uint8_t level, std::size_t from = 0) {
-    std::lock_guard<std::mutex> lock(mutex);
-    std::vector<std::string> out;
-    for (std::size_t i = from; i < logs.size(); ++i) {
-      if (logs[i].level == level &&
-          (instance.empty() || logs[i].msg.find("[" + instance + "]") != std::string::npos)) {
-        out.push_back(logs[i].msg);
-      }
-    }
-    return out;
-  }
-  std::size_t logCount() {
-    std::lock_guard<std::mutex> lock(mutex);
-    return logs.size();
-  }
-  /// Statuses of `instance` (diagnostic name "odo_a: laser odometry"), from index `from` on.
-  std::vector<diagnostic_msgs::DiagnosticStatus> statuses(const std::string& instance, std::size_t from = 0) {
-    std::lock_guard<std::mutex> lock(mutex);
-    std::vector<diagnostic_msgs::DiagnosticStatus> out;
-    const std::string prefix = instance.substr(1) + ":";
-    for (std::size_t i = from; i < diagnostics_all.size(); ++i) {
-      if (diagnostics_all[i].name.rfind(prefix, 0) == 0) out.push_back(diagnostics_all[i]);
-    }
-    return out;
-  }
-  std::size_t diagnosticsCount() {
-    std::lock_guard<std::mutex> lock(mutex);
-    return diagnostics_all.size();
-  }
-};
-
-std::string value(const diagnostic_msgs::DiagnosticStatus& status, const std::string& key) {
-  for (const auto& kv : status.values) {
-    if (kv.key == key) return kv.value;
-  }
-  return "";
-}
-
-/// Waits (wall clock, spinning in the background) until `done` or `timeout` seconds.
-bool waitFor(const std::function<bool()>& done, double timeout) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (done()) return true;
-    ros::WallDuration(0.005).sleep();
-  }
-  return done();
-}
-
-// ------------------------------------------------------------------ one simulated robot + its odometry
-
-/// A LaserScan message of a laser at `laser_pose` in `world`.
-sensor_msgs::LaserScan scanMsg(const hglasm_test::World& world, const Pose2D& laser_pose,
-                               const LaserSpec& laser, const ros::Time& stamp, const std::string& frame) {
-  const hglasm::RangeScan ranges = hglasm_test::simulateRanges(world, laser_pose, laser);
-  sensor_msgs::LaserScan msg;
-  msg.header.stamp = stamp;
-  msg.header.frame_id = frame;
-  msg.angle_min = static_cast<float>(ranges.angle_min);
-  msg.angle_increment = static_cast<float>(ranges.angle_increment);
-  msg.angle_max = static_cast<float>(ranges.angle_min + (ranges.ranges.size() - 1) * ranges.angle_increment);
-  msg.range_min = static_cast<float>(ranges.range_min);
-  msg.range_max = static_cast<float>(ranges.range_max);
-  msg.scan_time = 0.1f;
-  msg.ranges = ranges.ranges;
-  return msg;
-}
-
-struct RobotSetup {
-  std::string instance;     // private namespace of the nodelet, e.g. "/odo_a"
-  std::string scan_topic;   // what the nodelet subscribes as `scan`
-  std::string wheel_topic;  // what it subscribes as `odom` ("" = no wheel odometry published)
-  std::string odom_frame, base_frame, laser_frame;
-  Pose2D mount;  // base -> laser
-  Path path;     // base pose in the world over simulated time
-  LaserSpec laser;
-};
-
-class Robot {
- public:
-  Robot(ros::NodeHandle& nh, RobotSetup setup) : setup_(std::move(setup)), world_(hglasm_test::room()) {
-    scan_pub_ = nh.advertise<sensor_msgs::LaserScan>(setup_.scan_topic, 100);
-    if (!setup_.wheel_topic.empty()) wheel_pub_ = nh.advertise<nav_msgs::Odometry>(setup_.wheel_topic, 1000);
-    odom_sub_ = nh.subscribe<nav_msgs::Odometry>(setup_.instance + "/odom", 10000,
-                                                 [this](const nav_msgs::OdometryConstPtr& m) {
-                                                   std::lock_guard<std::mutex> lock(mutex_);
-                                                   odom_.push_back(*m);
-                                                 });
-    pose_sub_ = nh.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
-        setup_.instance + "/pose", 10000, [this](const geometry_msgs::PoseWithCovarianceStampedConstPtr& m) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          pose_.push_back(*m);
-        });
-    match_sub_ = nh.subscribe<Match>(setup_.instance + "/match", 10000, [this](const MatchConstPtr& m) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      match_.push_back(*m);
-    });
-  }
-
-  const RobotSetup& setup() const { return setup_; }
-  void setLaser(const LaserSpec& laser) { setup_.laser = laser; }
-
-  /// Subscribers of the nodelet connected to our publishers, and our subscribers to its outputs.
-  bool connected() const {
-    return scan_pub_.getNumSubscribers() > 0 && (!wheel_pub_ || wheel_pub_.getNumSubscribers() > 0) &&
-           odom_sub_.getNumPublishers() > 0 && match_sub_.getNumPublishers() > 0 &&
-           pose_sub_.getNumPublishers() > 0;
-  }
-
-  Pose2D truth(double t) const { return setup_.path(t); }
-
-  /// The scan the laser takes at simulated time t (stamped `stamp`).
-  sensor_msgs::LaserScan scanAt(double t, const ros::Time& stamp) const {
-    return scanMsg(world_, hglasm_test::composeByHand(truth(t), setup_.mount), setup_.laser, stamp,
-                   setup_.laser_frame);
-  }
-
-  /// Wheel odometry (exact, plus `wheel_offset` applied in the odometry frame) at 50 Hz stamps up to
-  /// `until`, continuing from the last published stamp (restarting if the stamps went back).
-  void publishWheel(double t_until, const ros::Time& stamp_until) {
-    if (!wheel_pub_) return;
-    const double stamp_offset = stamp_until.toSec() - t_until;
-    if (wheel_t_ > t_until + 1.0 || stamp_offset != wheel_stamp_offset_) wheel_t_ = t_until - 0.1;
-    wheel_stamp_offset_ = stamp_offset;
-    while (wheel_t_ + 0.02 <= t_until + 1e-9) {
-      wheel_t_ += 0.02;
-      const Pose2D pose = hglasm_test::composeByHand(wheel_offset_, truth(wheel_t_));
-      nav_msgs::Odometry msg;
-      msg.header.stamp = ros::Time(wheel_t_ + stamp_offset);
-      msg.header.frame_id = "wheel_odom";
-      msg.child_frame_id = setup_.base_frame;
-      msg.pose.pose = poseMsgFromPose2D(pose);
-      wheel_pub_.publish(msg);
-    }
-  }
-  void setWheelOffset(const Pose2D& offset) { wheel_offset_ = offset; }
-
-  void publishScan(const sensor_msgs::LaserScan& scan) { scan_pub_.publish(scan); }
-
-  std::size_t matchCount() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return match_.size();
-  }
-  std::size_t odomCount() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return odom_.size();
-  }
-  /// Waits for the match number `index` (0-based) and the ~odom published with it (~odom and ~match
-  /// travel on separate connections).
-  bool waitForMatch(std::size_t index, double timeout = 5.0) {
-    return waitFor(
-        [this, index] {
-          std::lock_guard<std::mutex> lock(mutex_);
-          if (match_.size() <= index) return false;
-          const ros::Time stamp = match_[index].header.stamp;
-          return std::any_of(odom_.begin(), odom_.end(),
-                             [&stamp](const nav_msgs::Odometry& o) { return o.header.stamp == stamp; });
-        },
-        timeout);
-  }
-  Match match(std::size_t index) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return match_.at(index);
-  }
-  /// The newest ~odom stamped `stamp`.
-  bool odomAt(const ros::Time& stamp, nav_msgs::Odometry* out) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (auto it = odom_.rbegin(); it != odom_.rend(); ++it) {
-      if (it->header.stamp == stamp) {
-        *out = *it;
-        return true;
-      }
-    }
-    return false;
-  }
-  std::vector<nav_msgs::Odometry> odometry() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return odom_;
-  }
-  std::vector<geometry_msgs::PoseWithCovarianceStamped> poses() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return pose_;
-  }
-  std::vector<Match> matches() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return match_;
-  }
-
- private:
-  RobotSetup setup_;
-  hglasm_test::World world_;
-  ros::Publisher scan_pub_, wheel_pub_;
-  ros::Subscriber odom_sub_, pose_sub_, match_sub_;
-  std::mutex mutex_;
-  std::vector<nav_msgs::Odometry> odom_;
-  std::vector<geometry_msgs::PoseWithCovarianceStamped> pose_;
-  std::vector<Match> match_;
-  double wheel_t_ = -1e9;
-  double wheel_stamp_offset_ = 0.0;
-  Pose2D wheel_offset_;
-};
-
-/// Clockwise circle of radius 1.5 m through the origin at 0.5 m/s (clear of the room's obstacles).
-Pose2D circlePath(double t) {
-  const double radius = 1.5, rate = 0.5 / radius;
-  return hglasm_test::rawPose(radius * std::sin(rate * t), -radius + radius * std::cos(rate * t),
-                              hglasm_test::angleDiff(-rate * t, 0.0));
-}
-
-/// Counter-clockwise circle of radius 1 m around (0, 1) at 0.4 m/s.
-Pose2D otherCirclePath(double t) {
-  const double radius = 1.0, rate = 0.4 / radius;
-  return hglasm_test::rawPose(radius * std::sin(rate * t), 1.0 - radius * std::cos(rate * t),
-                              hglasm_test::angleDiff(rate * t, 0.0));
-}
-
-void sendStaticTf(tf2_ros::StaticTransformBroadcaster* broadcaster, const RobotSetup& setup) {
-  geometry_msgs::TransformStamped t;
-  t.header.stamp = ros::Time(kStampOrigin);
-  t.header.frame_id = setup.base_frame;
-  t.child_frame_id = setup.laser_frame;
-  t.transform = transformMsgFromPose2D(setup.mount);
-  broadcaster->sendTransform(t);
-}
+using namespace rostest_sim;  // NOLINT: the shared simulated robot of the rostests
 
 // ------------------------------------------------------------------ the functional suite
 
@@ -347,7 +50,10 @@ struct Scene {
   // Simulated time and stamp offset of each robot: stamp = kStampOrigin + offset + t.
   double t_a = 0.0, offset_a = 0.0, t_b = 0.0;
   double origin_t_a = 0.0, origin_t_b = 0.0;  // simulated time of the last reset (the odometry origin)
-  double pace = 0.02;                         // wall seconds between steps (at least)
+  // A's published pose at origin_t_a: identity at a reset; where A was when the current test began (its
+  // accuracy is judged over the test, not over whatever ran before it in the shuffled order).
+  Pose2D origin_pose_a;
+  double pace = 0.02;  // wall seconds between steps (at least)
   ros::WallTime last_step;
 
   Scene() {
@@ -395,7 +101,10 @@ StepResult step(double dt = 0.1, const std::function<void(sensor_msgs::LaserScan
   result.ok_a = w.a->waitForMatch(index_a);
   if (result.ok_a) {
     result.a = w.a->match(index_a);
-    if (result.a.reset) w.origin_t_a = w.t_a;
+    if (result.a.reset) {
+      w.origin_t_a = w.t_a;
+      w.origin_pose_a = Pose2D();
+    }
   }
   if (with_b) {
     result.ok_b = w.b->waitForMatch(index_b);
@@ -407,13 +116,24 @@ StepResult step(double dt = 0.1, const std::function<void(sensor_msgs::LaserScan
   return result;
 }
 
-/// `robot`'s published pose at its newest match (simulated time `t`) vs the truth since `origin_t`.
+/// `robot`'s newest published pose (~odom), or false.
+bool newestPose(Robot& robot, Pose2D* pose) {
+  const Match m = robot.match(robot.matchCount() - 1);
+  nav_msgs::Odometry odom;
+  if (!robot.odomAt(m.header.stamp, &odom)) return false;
+  *pose = pose2D(odom.pose.pose);
+  return true;
+}
+
+/// `robot`'s published pose at its newest match (simulated time `t`) vs `origin_pose` (its pose at
+/// `origin_t`) moved by the truth since.
 void expectTracks(Robot& robot, double origin_t, double t, double max_translation, double max_rotation,
-                  const std::string& what) {
+                  const std::string& what, const Pose2D& origin_pose = Pose2D()) {
   const Match m = robot.match(robot.matchCount() - 1);
   nav_msgs::Odometry odom;
   ASSERT_TRUE(robot.odomAt(m.header.stamp, &odom)) << what << ": no ~odom for " << describe(m);
-  const Pose2D expected = hglasm_test::relativeByHand(robot.truth(origin_t), robot.truth(t));
+  const Pose2D expected = hglasm_test::composeByHand(
+      origin_pose, hglasm_test::relativeByHand(robot.truth(origin_t), robot.truth(t)));
   const Pose2D got = pose2D(odom.pose.pose);
   EXPECT_LT(hglasm_test::translationError(got, expected), max_translation)
       << what << ": " << got.x << " " << got.y << " " << got.theta << " vs " << expected.x << " "
@@ -421,10 +141,10 @@ void expectTracks(Robot& robot, double origin_t, double t, double max_translatio
   EXPECT_LT(hglasm_test::rotationError(got, expected), max_rotation) << what;
 }
 
-/// A's published pose at its newest match vs the truth since its last reset.
+/// A's published pose at its newest match vs the truth since the test began or A's last reset.
 void expectATracks(double max_translation, double max_rotation, const std::string& what) {
   Scene& w = *scene;
-  expectTracks(*w.a, w.origin_t_a, w.t_a, max_translation, max_rotation, what);
+  expectTracks(*w.a, w.origin_t_a, w.t_a, max_translation, max_rotation, what, w.origin_pose_a);
 }
 
 void expectBTracks(const std::string& what) {
@@ -446,12 +166,6 @@ void expectBTracks(const std::string& what) {
 std::vector<std::string> newLines(const std::string& instance, std::uint8_t level, std::size_t from) {
   ros::WallDuration(0.3).sleep();
   return scene->recorder.lines(instance, level, from);
-}
-
-std::string joined(const std::vector<std::string>& lines) {
-  std::string out;
-  for (const auto& l : lines) out += "\n  " + l;
-  return out;
 }
 
 /// Exactly one warning of /odo_a since `logs_before`, and it mentions `topic`.
@@ -505,6 +219,8 @@ void prepareScene() {
     const StepResult r = step();
     ASSERT_TRUE(r.ok_a && r.ok_b) << "no ~match from /odo_a or /odo_b";
   }
+  ASSERT_TRUE(newestPose(*w.a, &w.origin_pose_a));
+  w.origin_t_a = w.t_a;
   settleLogs();
 }
 
@@ -1168,18 +884,6 @@ TEST(Overload, FortyHertzOfLargeScansDropTheOldestCountThemAndDoNotGrowMemory) {
 }
 
 // ------------------------------------------------------------------ ~set_pose and the set-pose topic
-
-/// One scan of `robot` at simulated time t (stamped kStampOrigin + t), its wheel odometry first; the match
-/// and the ~odom published with it.
-bool scanStep(Robot& robot, double t, Match* match, nav_msgs::Odometry* odom) {
-  const ros::Time stamp(kStampOrigin + t);
-  const std::size_t index = robot.matchCount();
-  robot.publishWheel(t + 0.02, stamp + ros::Duration(0.02));
-  robot.publishScan(robot.scanAt(t, stamp));
-  if (!robot.waitForMatch(index)) return false;
-  *match = robot.match(index);
-  return robot.odomAt(stamp, odom);
-}
 
 /// A pose of the base in `frame`, stamped `stamp`, with x, y, yaw variances 0.04, 0.09, 0.01.
 geometry_msgs::PoseWithCovarianceStamped poseIn(const std::string& frame, const ros::Time& stamp,

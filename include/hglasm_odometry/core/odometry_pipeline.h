@@ -33,6 +33,11 @@ struct PipelineUpdate {
   /// Set when a match was attempted: the predicted pose of the new laser in the keyframe's laser frame,
   /// the guess the search was centred on.
   std::optional<Pose2D> laser_guess;
+  /// use_imu, and no IMU samples covered the step to this scan (stale or missing): the wheels (or the
+  /// velocity) predicted the rotation. Scans that start the odometry keep the previous scan's state.
+  bool imu_stale = false;
+  /// imu_stale differs from the previous scan's (at first: not stale): log once per change of state.
+  bool imu_stale_changed = false;
   double conversion_cpu_ms = 0.0;  ///< CPU time of the scan conversion (calling thread)
 };
 
@@ -46,7 +51,8 @@ struct PipelineUpdate {
 /// when odometry is off, when none has been added yet, or while odometry is stalled: a live node bounds
 /// each wait in wall time (odometry/wait) and reports a wait that timed out (odometryWaitTimedOut());
 /// scans then go on without waiting until the next sample arrives. Samples added beyond the first one
-/// at or after t change nothing: interpolation only uses the two around t.
+/// at or after t change nothing: interpolation only uses the two around t. With use_imu the IMU's samples
+/// are waited for the same way, and stall on their own.
 class OdometryPipeline {
  public:
   /// `wait_for_odometry` false: scans never wait for odometry (a live node with odometry/wait 0).
@@ -60,15 +66,21 @@ class OdometryPipeline {
   /// ignored (false).
   bool addOdometry(double stamp, const Pose2D& pose);
 
+  /// IMU: the base's yaw rate (rad/s), or its yaw (rad) with imu.use_orientation, at `stamp`; ignored
+  /// (false) without use_imu or for non-finite values.
+  bool addImu(double stamp, double value);
+
   /// Stamp of the newest odometry sample added; -infinity before the first.
   double newestOdometryStamp() const { return newest_odometry_stamp_; }
 
   /// The feeding policy (see the class comment): true once a scan stamped `stamp` may be processed.
   bool odometryReadyFor(double stamp) const;
 
-  /// A live wait for odometry timed out: odometry counts as stalled until the next sample arrives.
-  void odometryWaitTimedOut() { odometry_stalled_ = true; }
+  /// A live wait for a scan at `stamp` timed out: the wheel odometry, the IMU or both (whichever had no
+  /// sample at or after it) count as stalled until their next sample arrives.
+  void odometryWaitTimedOut(double stamp);
   bool odometryStalled() const { return odometry_stalled_; }
+  bool imuStalled() const { return imu_stalled_; }
 
   /// Offline replay of recorded odometry, under the feeding policy: adds the samples [next, end) (sorted
   /// by stamp; each with .stamp and .pose) that a live node holds when it processes a scan at `stamp`:
@@ -114,11 +126,16 @@ class OdometryPipeline {
   Pose2D base_to_laser_;
   double newest_odometry_stamp_ = -std::numeric_limits<double>::infinity();
   bool odometry_stalled_ = false;
+  double newest_imu_stamp_ = -std::numeric_limits<double>::infinity();
+  bool imu_stalled_ = false;
+  bool wheelsReadyFor(double stamp) const;
+  bool imuReadyFor(double stamp) const;
 
   bool have_geometry_ = false;
   std::size_t beam_count_ = 0;
   double angle_increment_ = 0.0;
   ScanError scan_error_ = ScanError::kNone;
+  bool imu_stale_ = false;
   Pose2D keyframe_pose_;  // base pose of the tracker's current keyframe, for the guess
 };
 

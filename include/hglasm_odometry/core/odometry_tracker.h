@@ -32,6 +32,11 @@ struct TrackerOptions {
   double odometry_max_extrapolation = 0.25;  ///< seconds; beyond, wheel odometry counts as stale
   double max_time_jump = 60.0;               ///< seconds forward between scans that triggers a reset
   bool use_odometry = true;
+  /// Take the rotation between scans from an IMU (addImu) whenever its samples cover the interval, with
+  /// imu's noise model; the wheels (or the velocity) predict the translation, and the rotation while the
+  /// IMU is stale or missing.
+  bool use_imu = false;
+  GyroOptions imu;
   /// Motion-compensate each scan with the current velocity estimate when its beams' times are known
   /// (Scan::time_increment): a sweep taken while moving is sheared, which a match reads as a small turn.
   bool deskew = true;
@@ -98,7 +103,9 @@ struct TrackerUpdate {
   double fitness_ratio = 0.0;
   Pose2D guess;  ///< predicted pose of the base (odometry frame) before matching
   PredictionSource prediction = PredictionSource::kNone;
-  SearchEffort search;              ///< box and GA size the scan was searched with
+  bool imu_rotation = false;  ///< the predicted rotation came from the IMU (use_imu and it covered the step)
+  double imu_bias = 0.0;      ///< rad/s: the gyro's bias learned so far (subtracted from its rotations)
+  SearchEffort search;        ///< box and GA size the scan was searched with
   double prior_mahalanobis = 0.0;   ///< Mahalanobis distance of the match from the prediction
   bool matched = false;             ///< a match was attempted (false for the first scan and after resets)
   bool fallback = false;            ///< match failed: the prediction was integrated instead
@@ -127,6 +134,10 @@ class OdometryTracker {
 
   /// Wheel odometry: pose of the base in the wheel-odometry frame at `stamp`.
   void addOdometry(double stamp, const Pose2D& odom_pose);
+
+  /// IMU: the base's yaw rate (rad/s) at `stamp`, or its yaw (rad) with options().imu.use_orientation.
+  /// Ignored (false) without use_imu or for non-finite values.
+  bool addImu(double stamp, double value) { return extrapolator_.addGyro(stamp, value); }
 
   /// Processes one scan (points in the laser frame) taken at `stamp` (seconds). If `population_out` is
   /// given, it receives the GA's final population as base poses in the odometry frame (for display).
@@ -211,7 +222,7 @@ class OdometryTracker {
   const LookupTable& judgingTable() const { return own_table_ ? *own_table_ : matcher_.table(); }
   /// log of the normal density of `pose` under a prior.
   static double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3d& covariance);
-  /// Learns the wheels' noise from the wheel increment against the scans' own increment.
+  /// Learns the wheels' noise and the gyro's bias from their increments against the scans' own.
   void learnNoise(const MotionPrediction& prediction, const MatchResult& match);
   Estimate integratePrediction(const MotionPrediction& prediction) const;
   void updateVelocity(double stamp, const Pose2D& new_pose, TrackerUpdate* update);
@@ -228,6 +239,7 @@ class OdometryTracker {
   PoseExtrapolator extrapolator_;
   KeyframePolicy keyframes_;
   MotionNoiseModel noise_;
+  GyroBiasEstimator gyro_bias_;
   LocalMap local_map_;
   Pose2D laser_mount_;
 
@@ -245,9 +257,10 @@ class OdometryTracker {
     double variance = 0.0;
     void add(double value);
   };
-  RunningStats fitness_;  // of accepted matches: how well scans usually fit the map
-  bool have_scan_only_pose_ = false;
-  Pose2D scan_only_pose_;  // base pose in the odometry frame where the last scan alone put it
+  RunningStats fitness_;              // of accepted matches: how well scans usually fit the map
+  bool have_scan_only_pose_ = false;  // and the last scan's prediction came from the wheels
+  bool have_scan_rotation_ = false;   // the last scan alone gave a usable pose
+  Pose2D scan_only_pose_;             // base pose in the odometry frame where the last scan alone put it
 
   int keyframe_id_ = 0;
 };

@@ -1,12 +1,14 @@
 // The motion of the base between two scans, predicted before the scan is matched (as Cartographer's
 // PoseExtrapolator): by wheel odometry when it covers both stamps and moves plausibly, else at the
-// velocity of the recent estimates; and that velocity, which also de-skews the scans.
+// velocity of the recent estimates, its rotation from an IMU when one covers both stamps; and that
+// velocity, which also de-skews the scans.
 #pragma once
 
 #include <Eigen/Core>
 #include <deque>
 #include <string>
 
+#include "hglasm_odometry/core/gyro.h"
 #include "hglasm_odometry/core/motion_model.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
 #include "hglasm_odometry/core/pose2d.h"
@@ -19,9 +21,14 @@ const char* toString(PredictionSource source);
 /// The predicted motion of the base between two stamps, in its frame at the first, and its noise.
 struct MotionPrediction {
   PredictionSource source = PredictionSource::kNone;
+  double dt = 0.0;  ///< seconds the motion spans
   Pose2D motion;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d nominal_covariance = Eigen::Matrix3d::Zero();  ///< wheels at unit noise scale
+  /// The wheels' part at unit noise scale (for learning their noise): zero where they predicted nothing.
+  Eigen::Matrix3d nominal_covariance = Eigen::Matrix3d::Zero();
+  /// The rotation (and its variance) came from the IMU; the translation is the wheels' (or the velocity's)
+  /// turned by half the difference of the two rotations, as the chord of an arc turns with it.
+  bool gyro = false;
 };
 
 /// Not thread-safe per instance.
@@ -30,12 +37,26 @@ class PoseExtrapolator {
   /// `use_odometry`: predict from wheel odometry at all. `max_odometry_age`: seconds past the newest sample
   /// it may be extrapolated. Wheel motion faster than `max_speed` (m/s) or `max_turn_rate` (rad/s), plus a
   /// margin of 0.2 m / 0.2 rad for jitter, is a jump; the velocity is capped at both too.
-  PoseExtrapolator(bool use_odometry, double max_odometry_age, double max_speed, double max_turn_rate);
+  /// `use_gyro`: take the rotation from the IMU samples (addGyro) whenever they cover the interval.
+  PoseExtrapolator(bool use_odometry, double max_odometry_age, double max_speed, double max_turn_rate,
+                   bool use_gyro = false, const GyroOptions& gyro = {});
 
   /// Wheel odometry: pose of the base in the wheel-odometry frame at `stamp`.
   void addOdometry(double stamp, const Pose2D& pose) { odometry_.add(stamp, pose); }
-  /// Forgets the wheel odometry (it belongs to another timeline, e.g. time went back).
-  void clearOdometry() { odometry_.clear(); }
+  /// IMU: the base's yaw rate (rad/s), or its yaw (rad) with GyroOptions::use_orientation, at `stamp`.
+  /// Ignored (false) without use_gyro or for non-finite values.
+  bool addGyro(double stamp, double value) { return use_gyro_ && gyro_.add(stamp, value); }
+  /// The gyro's bias (rad/s) and its variance, subtracted from the IMU's rotations from now on.
+  void setGyroBias(double bias, double variance) {
+    gyro_bias_ = bias;
+    gyro_bias_variance_ = variance;
+  }
+  /// Forgets the wheel odometry and the IMU samples (they belong to another timeline, e.g. time went
+  /// back).
+  void clearOdometry() {
+    odometry_.clear();
+    gyro_.clear();
+  }
 
   /// The motion of the base from `from` to `to`, with `noise`'s covariance. Sets *warning when the wheels
   /// jumped (the velocity predicts instead).
@@ -59,11 +80,21 @@ class PoseExtrapolator {
   static constexpr double kMaxVelocityAge = 2.0;    // seconds: older motion says nothing about the speed now
 
  private:
+  /// The wheels' or the velocity's prediction.
+  MotionPrediction predictTranslation(double from, double to, const MotionNoiseModel& noise,
+                                      std::string* warning) const;
+  /// Replaces the prediction's rotation by the IMU's, if it covers [from, to].
+  void applyGyro(double from, double to, MotionPrediction* prediction) const;
+
   bool use_odometry_;
   double max_odometry_age_;
   double max_speed_;
   double max_turn_rate_;
   OdometryBuffer odometry_;
+  bool use_gyro_;
+  GyroBuffer gyro_;
+  double gyro_bias_ = 0.0;
+  double gyro_bias_variance_;
   std::deque<StampedPose> poses_;  // recent estimates, for the velocity
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
   bool velocity_known_ = false;

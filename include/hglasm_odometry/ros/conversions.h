@@ -15,6 +15,7 @@
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Transform.h>
 #include <nav_msgs/Odometry.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/Header.h>
@@ -54,6 +55,15 @@ struct LaserMount {
 /// transform is not finite or its rotation is degenerate (laser plane vertical).
 bool laserMountFromTransform(const geometry_msgs::Transform& transform, LaserMount* mount,
                              std::string* error);
+
+/// What the odometry takes from a sensor_msgs/Imu: the base's yaw rate (rad/s), or with `use_orientation`
+/// its yaw (rad) in the IMU's world frame. `base_from_imu` is the IMU frame's rotation in base_frame (tf).
+/// The angular velocity is rotated into the base frame (a tilted or upside-down IMU) and its z taken; the
+/// orientation is composed with base_from_imu's inverse. False, with *error saying why, when the message
+/// says it has no such data (covariance[0] == -1, REP-145), a value is not finite, or a quaternion cannot
+/// be normalised.
+bool imuValueFromMsg(const sensor_msgs::Imu& msg, const geometry_msgs::Quaternion& base_from_imu,
+                     bool use_orientation, double* value, std::string* error);
 
 /// Yaw of a quaternion (normalised first); 0 for a zero-length or non-finite quaternion.
 double yawFromQuaternion(const geometry_msgs::Quaternion& q);

@@ -1,5 +1,5 @@
-// The live laser odometry: scans (+ wheel odometry) in, odometry, pose, tf, path, match statistics and
-// diagnostics out. Shared by the nodelet and the node; holds no global state, so several instances can
+// The live laser odometry: scans (+ wheel odometry, + an IMU) in, odometry, pose, tf, path, match statistics
+// and diagnostics out. Shared by the nodelet and the node; holds no global state, so several instances can
 // live in one process.
 //
 // Threads: the subscription callbacks, ~reset and ~set_pose only enqueue (scans in a bounded queue that
@@ -28,6 +28,7 @@
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
@@ -43,7 +44,7 @@ namespace hglasm_odometry {
 
 class LaserOdometry {
  public:
-  /// `nh` resolves the input topics (`scan`, `odom`), `private_nh` the outputs (~odom, ~pose, ~path,
+  /// `nh` resolves the input topics (`scan`, `odom`, `imu`), `private_nh` the outputs (~odom, ~pose, ~path,
   /// ~match, ~ga_population, ~local_map), ~reset, ~set_pose and the set-pose topic (set_pose/topic, when
   /// enabled). `options` must come from loadOptions() (already validated).
   LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
@@ -64,6 +65,7 @@ class LaserOdometry {
 
   void scanCallback(const sensor_msgs::LaserScanConstPtr& msg);
   void odomCallback(const nav_msgs::OdometryConstPtr& msg);
+  void imuCallback(const sensor_msgs::ImuConstPtr& msg);
   bool resetCallback(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool setPoseCallback(SetPose::Request& request, SetPose::Response& response);
   void setPoseTopicCallback(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg);
@@ -88,6 +90,11 @@ class LaserOdometry {
   bool waitForOdometry(double stamp);
   /// Looks up base -> laser for `laser_frame` (cached); false while tf does not have it yet.
   bool ensureLaserMount(const std::string& laser_frame);
+  /// Hands one IMU message to the pipeline, rotated into base_frame (base -> its frame cached from tf);
+  /// dropped with a throttled warning while tf lacks it or the message is unusable. Worker only.
+  void addImu(const sensor_msgs::Imu& msg);
+  /// Logs once when the IMU stops covering the steps between scans and once when it is back.
+  void reportImuState(const hglasm::PipelineUpdate& update);
   void processScan(const sensor_msgs::LaserScan& msg);
   /// ~odom, ~pose, tf and ~path (for a published estimate) and ~match of one scan.
   void publish(const sensor_msgs::LaserScan& msg, const hglasm::PipelineUpdate& update, double total_ms);
@@ -111,6 +118,7 @@ class LaserOdometry {
   std::condition_variable input_cv_;
   std::deque<sensor_msgs::LaserScanConstPtr> scans_;  // bounded by options_.queue_size
   std::deque<OdometrySample> odometry_;
+  std::deque<sensor_msgs::ImuConstPtr> imu_;
   std::uint32_t dropped_scans_ = 0;
   bool reset_requested_ = false;
   std::optional<PoseRequest> pose_requested_;  // a reset request clears it, and it a reset request
@@ -124,6 +132,7 @@ class LaserOdometry {
   bool local_map_sent_ = false;
   std::uint64_t local_map_revision_ = 0;  // hglasm::LocalMap::revision() of the last ~local_map sent
   bool warned_odom_child_frame_ = false;
+  std::map<std::string, geometry_msgs::Quaternion> imu_mounts_;  // base -> IMU frame rotation, per frame_id
 
   // Diagnostics (guarded by stats_mutex_).
   std::mutex stats_mutex_;
@@ -135,6 +144,7 @@ class LaserOdometry {
   std::uint32_t last_reported_drops_ = 0;  // dropped_scans_ at the previous diagnostics report
   ros::WallTime last_scan_time_;
   bool waiting_for_tf_ = false;
+  bool imu_stale_ = false;  // use_imu, and the last scan's rotation did not come from the IMU
   std::string tf_wait_text_;
 
   // Log throttling (per instance; rosconsole's THROTTLE macros share one timer between instances); guarded
@@ -162,6 +172,7 @@ class LaserOdometry {
   ros::WallTimer diagnostics_timer_;
   ros::Subscriber scan_sub_;
   ros::Subscriber odom_sub_;
+  ros::Subscriber imu_sub_;
 
   std::thread worker_;  // started last, joined first
 };

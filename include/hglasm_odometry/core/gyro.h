@@ -1,0 +1,94 @@
+// The rotation of the base between two stamps from an IMU: its yaw rate integrated, or the difference of
+// its yaw; how far that rotation may be off; and the gyro's bias, learned from the scan matches.
+#pragma once
+
+#include <deque>
+
+namespace hglasm {
+
+struct GyroOptions {
+  /// Take the rotation from the IMU's orientation (the difference of its yaw) instead of integrating its
+  /// yaw rate: for IMUs whose own filter estimates the gyro's bias.
+  bool use_orientation = false;
+  /// Seconds: a gap between IMU samples longer than this, or a stamp farther than this beyond the
+  /// samples, makes the IMU stale for that interval (the wheels predict the rotation instead).
+  double max_gap = 0.1;
+  /// The rotation's noise: white rate noise (angle random walk, rad per sqrt(s)); ...
+  double angle_random_walk = 0.002;
+  /// ... an unknown bias (standard deviation, rad/s), whose error grows with the interval, until the
+  /// matches have taught its value (estimate_bias); ...
+  double bias = 0.005;
+  /// ... and an error proportional to the rotation (scale factor, and stamps of the IMU and the laser a
+  /// few milliseconds apart): the fraction of the rotation it reaches (standard deviation).
+  double scale_error = 0.02;
+  /// Learn the bias from the matches: every matched step compares the IMU's rotation with the scans'.
+  bool estimate_bias = true;
+  /// How fast the bias wanders (temperature, time): rad/s per sqrt(s), a random walk.
+  double bias_random_walk = 1e-4;
+};
+
+/// Variance (rad^2) of a gyro rotation of `angle` radians over `dt` seconds under `options`' noise model,
+/// with a bias known to `bias_variance` ((rad/s)^2; options.bias squared before anything is learned).
+double gyroRotationVariance(const GyroOptions& options, double angle, double dt, double bias_variance);
+
+/// The gyro's bias as a scalar Kalman filter: a random walk (bias_random_walk) observed by each matched
+/// step, the IMU's rotation against the scans'. Not thread-safe per instance.
+class GyroBiasEstimator {
+ public:
+  explicit GyroBiasEstimator(const GyroOptions& options = {});
+
+  /// One step of `dt` s: `predicted` is the IMU's rotation corrected by bias() (as the prediction used it),
+  /// `measured` the scans' rotation over the same step, with variance `measured_variance`. A difference
+  /// beyond kGate standard deviations of what the filter expects counts as kGate (a bad match moves the
+  /// estimate a little, a real bias far outside the prior is still learned, step by step). Ignored (false)
+  /// without estimate_bias or for non-finite or non-positive input.
+  bool update(double predicted, double measured, double measured_variance, double dt);
+
+  double bias() const { return bias_; }          ///< rad/s
+  double variance() const { return variance_; }  ///< (rad/s)^2
+  /// Back to no knowledge: zero with options.bias's variance.
+  void reset();
+
+  static constexpr double kGate = 4.0;
+
+ private:
+  GyroOptions options_;
+  double bias_ = 0.0;
+  double variance_ = 0.0;
+};
+
+/// A short history of IMU samples: the base's yaw rate (rad/s), or its yaw (rad) when
+/// options.use_orientation. Not thread-safe per instance.
+class GyroBuffer {
+ public:
+  explicit GyroBuffer(const GyroOptions& options = {});
+
+  /// Adds a sample (out-of-order samples are inserted in place); non-finite ones are rejected (false).
+  bool add(double stamp, double value);
+
+  /// The rotation of the base from `from` to `to` (from <= to): the rate integrated along its linear
+  /// interpolation between samples (held beyond the ends), or the yaw at `to` minus the yaw at `from`
+  /// along the samples between (so several turns between two scans count). False when the samples do not
+  /// cover the interval: a gap longer than max_gap, or an end farther than max_gap beyond the samples.
+  bool rotation(double from, double to, double* angle) const;
+
+  void clear() { samples_.clear(); }
+  bool empty() const { return samples_.empty(); }
+  const GyroOptions& options() const { return options_; }
+
+  static constexpr double kKeptSeconds = 10.0;  // history kept behind the newest sample
+
+ private:
+  struct Sample {
+    double stamp;
+    double value;
+  };
+  /// The value at `stamp`, linear between the samples around it (yaw along the shorter arc), the end
+  /// sample's beyond them.
+  double valueAt(double stamp) const;
+
+  GyroOptions options_;
+  std::deque<Sample> samples_;
+};
+
+}  // namespace hglasm

@@ -1,0 +1,103 @@
+#include "hglasm_odometry/core/gyro.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "hglasm_odometry/core/pose2d.h"
+
+namespace hglasm {
+namespace {
+
+double square(double value) { return value * value; }
+
+}  // namespace
+
+double gyroRotationVariance(const GyroOptions& options, double angle, double dt, double bias_variance) {
+  const double elapsed = std::isfinite(dt) ? std::max(0.0, dt) : 0.0;
+  const double turned = std::isfinite(angle) ? std::abs(angle) : 0.0;
+  const double bias = std::isfinite(bias_variance) ? std::max(0.0, bias_variance) : square(options.bias);
+  const double variance = square(options.angle_random_walk) * elapsed + bias * square(elapsed) +
+                          square(options.scale_error * turned);
+  return std::max(variance, 1e-12);  // a covariance must stay invertible
+}
+
+GyroBiasEstimator::GyroBiasEstimator(const GyroOptions& options) : options_(options) { reset(); }
+
+void GyroBiasEstimator::reset() {
+  bias_ = 0.0;
+  variance_ = square(options_.bias);
+}
+
+bool GyroBiasEstimator::update(double predicted, double measured, double measured_variance, double dt) {
+  if (!options_.estimate_bias || !std::isfinite(predicted) || !std::isfinite(measured) ||
+      !std::isfinite(measured_variance) || measured_variance < 0.0 || !std::isfinite(dt) || !(dt > 0.0)) {
+    return false;
+  }
+  variance_ += square(options_.bias_random_walk) * dt;
+  // The step's innovation is the bias error times dt, plus the gyro's white and scale noise and the scans'.
+  const double innovation = normalizeAngle(predicted - measured);
+  const double noise =
+      square(options_.angle_random_walk) * dt + square(options_.scale_error * measured) + measured_variance;
+  const double expected = variance_ * dt * dt + noise;
+  const double gate = kGate * std::sqrt(expected);
+  const double gain = variance_ * dt / expected;
+  bias_ += gain * std::clamp(innovation, -gate, gate);
+  variance_ = std::max(0.0, (1.0 - gain * dt) * variance_);
+  return true;
+}
+
+GyroBuffer::GyroBuffer(const GyroOptions& options) : options_(options) {}
+
+bool GyroBuffer::add(double stamp, double value) {
+  if (!std::isfinite(stamp) || !std::isfinite(value)) return false;
+  const auto later = std::upper_bound(samples_.begin(), samples_.end(), stamp,
+                                      [](double t, const Sample& sample) { return t < sample.stamp; });
+  samples_.insert(later, Sample{stamp, value});
+  const double oldest_kept = samples_.back().stamp - kKeptSeconds;
+  while (samples_.size() > 2 && samples_.front().stamp < oldest_kept) samples_.pop_front();
+  return true;
+}
+
+double GyroBuffer::valueAt(double stamp) const {
+  if (stamp <= samples_.front().stamp) return samples_.front().value;
+  if (stamp >= samples_.back().stamp) return samples_.back().value;
+  const auto upper = std::upper_bound(samples_.begin(), samples_.end(), stamp,
+                                      [](double t, const Sample& sample) { return t < sample.stamp; });
+  const Sample& a = *(upper - 1);
+  const Sample& b = *upper;
+  const double fraction = (stamp - a.stamp) / (b.stamp - a.stamp);  // a.stamp < stamp < b.stamp
+  if (options_.use_orientation) return a.value + fraction * normalizeAngle(b.value - a.value);
+  return a.value + fraction * (b.value - a.value);
+}
+
+bool GyroBuffer::rotation(double from, double to, double* angle) const {
+  if (samples_.empty() || !std::isfinite(from) || !std::isfinite(to) || to < from) return false;
+  if (from < samples_.front().stamp - options_.max_gap || to > samples_.back().stamp + options_.max_gap) {
+    return false;
+  }
+  // Every instant of the interval must lie between two samples at most max_gap apart (or within max_gap
+  // of the end sample beyond them).
+  const auto after_from = std::upper_bound(samples_.begin(), samples_.end(), from,
+                                           [](double t, const Sample& sample) { return t < sample.stamp; });
+  for (auto it = after_from == samples_.begin() ? after_from : after_from - 1;
+       it + 1 != samples_.end() && it->stamp < to; ++it) {
+    if ((it + 1)->stamp - it->stamp > options_.max_gap) return false;
+  }
+  // The knots of the piecewise-linear signal between the two stamps: the ends and every sample between.
+  std::vector<Sample> knots{{from, valueAt(from)}};
+  for (auto it = after_from; it != samples_.end() && it->stamp < to; ++it) knots.push_back(*it);
+  knots.push_back({to, valueAt(to)});
+  double sum = 0.0;
+  for (std::size_t i = 1; i < knots.size(); ++i) {
+    if (options_.use_orientation) {
+      sum += normalizeAngle(knots[i].value - knots[i - 1].value);
+    } else {
+      sum += 0.5 * (knots[i].value + knots[i - 1].value) * (knots[i].stamp - knots[i - 1].stamp);
+    }
+  }
+  *angle = sum;
+  return true;
+}
+
+}  // namespace hglasm
