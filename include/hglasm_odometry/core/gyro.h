@@ -13,7 +13,8 @@ struct GyroOptions {
   /// Seconds: a gap between IMU samples longer than this, or a stamp farther than this beyond the
   /// samples, makes the IMU stale for that interval (the wheels predict the rotation instead).
   double max_gap = 0.1;
-  /// The rotation's noise: white rate noise (angle random walk, rad per sqrt(s)); ...
+  /// The rotation's noise: white rate noise (angle random walk, rad per sqrt(s); 0.002 is 0.11 deg/s per
+  /// sqrt(Hz), ten times a consumer MEMS gyro's datasheet figure, for a robot's vibration); ...
   double angle_random_walk = 0.002;
   /// ... an unknown bias (standard deviation, rad/s), whose error grows with the interval, until the
   /// matches have taught its value (estimate_bias); ...
