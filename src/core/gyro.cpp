@@ -16,7 +16,8 @@ double square(double value) { return value * value; }
 double gyroRotationVariance(const GyroOptions& options, double angle, double dt, double bias_variance) {
   const double elapsed = std::isfinite(dt) ? std::max(0.0, dt) : 0.0;
   const double turned = std::isfinite(angle) ? std::abs(angle) : 0.0;
-  const double bias = std::isfinite(bias_variance) ? std::max(0.0, bias_variance) : square(options.bias);
+  const double bias =
+      std::isfinite(bias_variance) ? std::max(0.0, bias_variance) : square(options.bias_sigma);
   const double variance = square(options.angle_random_walk) * elapsed + bias * square(elapsed) +
                           square(options.scale_error * turned);
   return std::max(variance, 1e-12);  // a covariance must stay invertible
@@ -26,24 +27,42 @@ GyroBiasEstimator::GyroBiasEstimator(const GyroOptions& options) : options_(opti
 
 void GyroBiasEstimator::reset() {
   bias_ = 0.0;
-  variance_ = square(options_.bias);
+  variance_ = square(options_.bias_sigma);
+  have_stamp_ = false;
+  mean_sigmas_ = mean_bias_error_ = 0.0;
 }
 
-bool GyroBiasEstimator::update(double predicted, double measured, double measured_variance, double dt) {
+bool GyroBiasEstimator::update(double predicted, double measured, double measured_variance, double dt,
+                               double stamp) {
   if (!options_.estimate_bias || !std::isfinite(predicted) || !std::isfinite(measured) ||
-      !std::isfinite(measured_variance) || measured_variance < 0.0 || !std::isfinite(dt) || !(dt > 0.0)) {
+      !std::isfinite(measured_variance) || measured_variance < 0.0 || !std::isfinite(dt) || !(dt > 0.0) ||
+      !std::isfinite(stamp)) {
     return false;
   }
-  variance_ += square(options_.bias_random_walk) * dt;
+  const double elapsed = have_stamp_ ? std::max(dt, stamp - last_stamp_) : dt;
+  last_stamp_ = stamp;
+  have_stamp_ = true;
+  variance_ += square(options_.bias_random_walk) * elapsed;
   // The step's innovation is the bias error times dt, plus the gyro's white and scale noise and the scans'.
   const double innovation = normalizeAngle(predicted - measured);
   const double noise =
       square(options_.angle_random_walk) * dt + square(options_.scale_error * measured) + measured_variance;
   const double expected = variance_ * dt * dt + noise;
+  if (!(expected > 0.0)) return false;
   const double gate = kGate * std::sqrt(expected);
   const double gain = variance_ * dt / expected;
   bias_ += gain * std::clamp(innovation, -gate, gate);
   variance_ = std::max(0.0, (1.0 - gain * dt) * variance_);
+  // Innovations that keep leaning one way (their recent mean, in sigmas, far from 0) say the bias moved
+  // faster than bias_random_walk allows (an IMU that recalibrated, a warming sensor): widen the variance
+  // to the bias error they show, and the next steps follow it.
+  const double weight = 1.0 / kInnovationMemory;
+  mean_sigmas_ = (1.0 - weight) * mean_sigmas_ + weight * innovation / std::sqrt(expected);
+  mean_bias_error_ = (1.0 - weight) * mean_bias_error_ + weight * innovation / dt;
+  if (std::abs(mean_sigmas_) > kDriftSigmas) {
+    variance_ = std::max(variance_, square(mean_bias_error_));
+    mean_sigmas_ = mean_bias_error_ = 0.0;
+  }
   return true;
 }
 
@@ -54,14 +73,25 @@ bool GyroBuffer::add(double stamp, double value) {
   const auto later = std::upper_bound(samples_.begin(), samples_.end(), stamp,
                                       [](double t, const Sample& sample) { return t < sample.stamp; });
   samples_.insert(later, Sample{stamp, value});
-  const double oldest_kept = samples_.back().stamp - kKeptSeconds;
-  while (samples_.size() > 2 && samples_.front().stamp < oldest_kept) samples_.pop_front();
+  if (samples_.size() > kMaxSamples) samples_.pop_front();
   return true;
 }
 
+void GyroBuffer::forgetBefore(double stamp) {
+  while (samples_.size() > 1 && samples_[1].stamp <= stamp) samples_.pop_front();
+}
+
 double GyroBuffer::valueAt(double stamp) const {
-  if (stamp <= samples_.front().stamp) return samples_.front().value;
-  if (stamp >= samples_.back().stamp) return samples_.back().value;
+  const auto beyond = [this, stamp](const Sample& end, const Sample& inner) {
+    // The rate is held; the yaw goes on at the end segment's rate.
+    if (!options_.use_orientation || end.stamp == inner.stamp) return end.value;
+    return end.value +
+           (stamp - end.stamp) * normalizeAngle(end.value - inner.value) / (end.stamp - inner.stamp);
+  };
+  if (stamp <= samples_.front().stamp)
+    return beyond(samples_.front(), samples_[std::min<std::size_t>(1, samples_.size() - 1)]);
+  if (stamp >= samples_.back().stamp)
+    return beyond(samples_.back(), samples_[samples_.size() >= 2 ? samples_.size() - 2 : 0]);
   const auto upper = std::upper_bound(samples_.begin(), samples_.end(), stamp,
                                       [](double t, const Sample& sample) { return t < sample.stamp; });
   const Sample& a = *(upper - 1);

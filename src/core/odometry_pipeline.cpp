@@ -28,7 +28,7 @@ ScanConversionOptions conversionForMount(ScanConversionOptions conversion, bool 
 }
 
 OdometryPipeline::OdometryPipeline(const TrackerOptions& options, bool wait_for_odometry)
-    : tracker_(options), wait_for_odometry_(wait_for_odometry), conversion_(options.conversion) {}
+    : tracker_(options), wait_for_inputs_(wait_for_odometry), conversion_(options.conversion) {}
 
 bool OdometryPipeline::setLaserMount(const Pose2D& base_to_laser, bool upside_down) {
   if (!base_to_laser.isFinite()) return false;
@@ -43,34 +43,34 @@ bool OdometryPipeline::addOdometry(double stamp, const Pose2D& pose) {
   if (!std::isfinite(stamp) || !pose.isFinite()) return false;
   tracker_.addOdometry(stamp, pose);
   if (stamp > newest_odometry_stamp_) newest_odometry_stamp_ = stamp;
-  odometry_stalled_ = false;
+  if (!(stamp < last_scan_stamp_)) odometry_stalled_ = false;
   return true;
 }
 
 bool OdometryPipeline::addImu(double stamp, double value) {
   if (!tracker_.addImu(stamp, value)) return false;
   if (stamp > newest_imu_stamp_) newest_imu_stamp_ = stamp;
-  imu_stalled_ = false;
+  if (!(stamp < last_scan_stamp_)) imu_stalled_ = false;
   return true;
 }
 
 bool OdometryPipeline::wheelsReadyFor(double stamp) const {
-  if (!tracker_.options().use_odometry || !wait_for_odometry_) return true;
+  if (!tracker_.options().use_odometry || !wait_for_inputs_) return true;
   if (!std::isfinite(newest_odometry_stamp_)) return true;  // none yet: nothing to wait for
   return odometry_stalled_ || newest_odometry_stamp_ >= stamp;
 }
 
 bool OdometryPipeline::imuReadyFor(double stamp) const {
-  if (!tracker_.options().use_imu || !wait_for_odometry_) return true;
+  if (!tracker_.options().use_imu || !wait_for_inputs_) return true;
   if (!std::isfinite(newest_imu_stamp_)) return true;
   return imu_stalled_ || newest_imu_stamp_ >= stamp;
 }
 
-bool OdometryPipeline::odometryReadyFor(double stamp) const {
+bool OdometryPipeline::inputsReadyFor(double stamp) const {
   return wheelsReadyFor(stamp) && imuReadyFor(stamp);
 }
 
-void OdometryPipeline::odometryWaitTimedOut(double stamp) {
+void OdometryPipeline::inputsWaitTimedOut(double stamp) {
   if (!wheelsReadyFor(stamp)) odometry_stalled_ = true;
   if (!imuReadyFor(stamp)) imu_stalled_ = true;
 }
@@ -98,6 +98,7 @@ std::string OdometryPipeline::checkGeometry(const RangeScan& ranges) {
 PipelineUpdate OdometryPipeline::processScan(double stamp, const RangeScan& ranges,
                                              std::vector<Pose2D>* population) {
   PipelineUpdate update;
+  if (std::isfinite(stamp)) last_scan_stamp_ = stamp;
   const double cpu_start = threadCpuMs();
   update.scan = scanFromRanges(ranges, conversion_, &update.scan_error);
   update.conversion_cpu_ms = threadCpuMs() - cpu_start;
@@ -117,7 +118,7 @@ PipelineUpdate OdometryPipeline::processScan(double stamp, const RangeScan& rang
   }
   if (result.new_keyframe) keyframe_pose_ = result.pose;
   if (tracker_.options().use_imu && result.published && !result.reset) {
-    update.imu_stale = !result.imu_rotation;
+    update.imu_stale = !result.rotation_from_imu;
     update.imu_stale_changed = update.imu_stale != imu_stale_;
     imu_stale_ = update.imu_stale;
   } else {

@@ -401,22 +401,20 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   update->fitness_ratio = chosen.fitness_ratio;
   fitness_.add(chosen.fitness_ratio);
   estimateFrom(chosen, h, estimate);
-  if (!update->leap) {
-    learnNoise(prediction, chosen.match);
-  } else {
-    // The prediction was wrong beyond its noise: an outlier, not the wheels' noise or the gyro's bias.
-    have_scan_only_pose_ = have_scan_rotation_ = false;
-  }
+  // After a leap the wheels were wrong beyond their noise: an outlier, not their noise. The gyro's bias
+  // is still learned (its filter clips what it cannot explain): a bias far off makes leaps of its own.
+  learnNoise(prediction, chosen.match, !update->leap);
   return true;
 }
 
-void OdometryTracker::learnNoise(const MotionPrediction& prediction, const MatchResult& match) {
+void OdometryTracker::learnNoise(const MotionPrediction& prediction, const MatchResult& match,
+                                 bool learn_wheels) {
   // Two consecutive scans matched against the same map share most of their error, so the motion between
   // where the scans alone put them is a far better measurement of the increment than any wheels': what
   // the wheels' increment differs from it by is (almost all) their noise.
   const Pose2D scan_only = fromMap(match.scan_only_pose);
   const bool scan_usable = !match.degenerate && scan_only.isFinite();
-  const bool usable = prediction.source == PredictionSource::kOdometry && scan_usable;
+  const bool usable = learn_wheels && prediction.source == PredictionSource::kOdometry && scan_usable;
   if (usable && have_scan_only_pose_) {
     const Pose2D wheel_error = relativePose(prediction.motion, relativePose(scan_only_pose_, scan_only));
     noise_.learn(Eigen::Vector3d(wheel_error.x, wheel_error.y, wheel_error.theta), Eigen::Vector3d::Zero(),
@@ -424,7 +422,8 @@ void OdometryTracker::learnNoise(const MotionPrediction& prediction, const Match
   }
   if (prediction.gyro && scan_usable && have_scan_rotation_) {
     const double scan_rotation = normalizeAngle(scan_only.theta - scan_only_pose_.theta);
-    if (gyro_bias_.update(prediction.motion.theta, scan_rotation, kScanRotationVariance, prediction.dt)) {
+    if (gyro_bias_.update(prediction.motion.theta, scan_rotation, kScanRotationVariance, prediction.dt,
+                          last_stamp_ + prediction.dt)) {
       extrapolator_.setGyroBias(gyro_bias_.bias(), gyro_bias_.variance());
     }
   }
@@ -459,7 +458,7 @@ bool OdometryTracker::handleTime(double stamp, TrackerUpdate* update) {
   reset();
   // Back in time, the odometry history is of another timeline (a looped bag, a clock reset): mixed with
   // the new samples at the same stamps it would turn every prediction into a jump.
-  if (dt < 0.0) extrapolator_.clearOdometry();
+  if (dt < 0.0) extrapolator_.clearSensorHistory();
   return false;
 }
 
@@ -553,7 +552,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   const MotionPrediction prediction = extrapolator_.predict(last_stamp_, stamp, noise_, &prediction_warning);
   if (update.warning.empty()) update.warning = prediction_warning;
   update.prediction = prediction.source;
-  update.imu_rotation = prediction.gyro;
+  update.rotation_from_imu = prediction.gyro;
   update.guess = pose_ * prediction.motion;
 
   Estimate estimate;
@@ -586,6 +585,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   updateVelocity(stamp, new_pose, &update);
   pose_ = new_pose;
   last_stamp_ = stamp;
+  extrapolator_.forgetGyroBefore(stamp);  // the next step starts here
   updateKeyframe(scan, usable, &update);
 
   update.published = true;

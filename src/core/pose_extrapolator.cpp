@@ -26,31 +26,48 @@ PoseExtrapolator::PoseExtrapolator(bool use_odometry, double max_odometry_age, d
       max_turn_rate_(max_turn_rate),
       use_gyro_(use_gyro),
       gyro_(gyro),
-      gyro_bias_variance_(gyro.bias * gyro.bias) {}
+      gyro_bias_variance_(gyro.bias_sigma * gyro.bias_sigma) {}
 
 MotionPrediction PoseExtrapolator::predict(double from, double to, const MotionNoiseModel& noise,
                                            std::string* warning) const {
   MotionPrediction prediction = predictTranslation(from, to, noise, warning);
   prediction.dt = to - from;
-  if (use_gyro_) applyGyro(from, to, &prediction);
+  if (use_gyro_) applyGyro(from, to, &prediction, warning);
   return prediction;
 }
 
-void PoseExtrapolator::applyGyro(double from, double to, MotionPrediction* prediction) const {
+void PoseExtrapolator::applyGyro(double from, double to, MotionPrediction* prediction,
+                                 std::string* warning) const {
   double raw_angle = 0.0;
   if (!gyro_.rotation(from, to, &raw_angle)) return;
-  const double angle = raw_angle - gyro_bias_ * (to - from);
-  // Along an arc the chord turns by half the rotation: with the rotation corrected, so is the chord.
-  const double correction = 0.5 * (angle - prediction->motion.theta);
-  const double c = std::cos(correction), s = std::sin(correction);
-  const Pose2D& motion = prediction->motion;
-  prediction->motion = Pose2D(c * motion.x - s * motion.y, s * motion.x + c * motion.y, angle);
-  // The heading's noise is the IMU's alone, independent of the translation's.
-  for (Eigen::Matrix3d* covariance : {&prediction->covariance, &prediction->nominal_covariance}) {
-    covariance->row(2).setZero();
-    covariance->col(2).setZero();
+  const double dt = to - from;
+  const double angle = raw_angle - gyro_bias_ * dt;
+  if (std::abs(angle) > max_turn_rate_ * dt + 0.2) {
+    std::ostringstream text;
+    text << "IMU rotation of " << angle << " rad in " << dt << " s is faster than odometry/max_turn_rate; "
+         << "the rotation is predicted without it";
+    if (warning->empty()) *warning = text.str();
+    return;
   }
-  prediction->covariance(2, 2) = gyroRotationVariance(gyro_.options(), angle, to - from, gyro_bias_variance_);
+  // Along an arc the chord turns by half the rotation: with the rotation corrected, so is the chord.
+  const double correction = 0.5 * normalizeAngle(angle - prediction->motion.theta);
+  const double c = std::cos(correction), s = std::sin(correction);
+  const Eigen::Vector2d chord(c * prediction->motion.x - s * prediction->motion.y,
+                              s * prediction->motion.x + c * prediction->motion.y);
+  prediction->motion = Pose2D(chord.x(), chord.y(), angle);
+  // First order: the chord turned by the correction, and moved by half of any error of the rotation.
+  Eigen::Matrix3d to_gyro = Eigen::Matrix3d::Zero();
+  to_gyro.topLeftCorner<2, 2>() << c, -s, s, c;
+  const Eigen::Vector3d chord_per_radian(-0.5 * chord.y(), 0.5 * chord.x(), 1.0);
+  const double angle_variance = gyroRotationVariance(gyro_.options(), angle, dt, gyro_bias_variance_);
+  for (Eigen::Matrix3d* covariance : {&prediction->covariance, &prediction->nominal_covariance}) {
+    const Eigen::Matrix2d translation = covariance->topLeftCorner<2, 2>();
+    covariance->setZero();
+    covariance->topLeftCorner<2, 2>() =
+        to_gyro.topLeftCorner<2, 2>() * translation * to_gyro.topLeftCorner<2, 2>().transpose();
+  }
+  // The heading's noise is the IMU's alone (the wheels' heading noise is not learned from this step).
+  prediction->covariance += angle_variance * chord_per_radian * chord_per_radian.transpose();
   prediction->gyro = true;
 }
 

@@ -38,7 +38,7 @@ visualization_msgs::Marker arrowMarker(const std_msgs::Header& header, int id, c
 /// Match's fields that say what happened to the scan and how it was searched.
 void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
   match->prediction_source = toMsg(update.prediction);
-  match->imu_rotation = update.imu_rotation;
+  match->rotation_from_imu = update.rotation_from_imu;
   match->imu_bias = finiteFloat(update.imu_bias);
   match->status = toMsg(update.match.status);
   match->status_text = hglasm::toString(update.match.status);

@@ -140,12 +140,59 @@ void LaserOdometry::odomCallback(const nav_msgs::OdometryConstPtr& msg) {
 }
 
 void LaserOdometry::imuCallback(const sensor_msgs::ImuConstPtr& msg) {
+  // Converted here, outside the worker's lock: a tf lookup per message must not hold up the other inputs.
+  ImuSample sample;
+  if (!imuValueInBase(*msg, &sample.value)) return;
+  sample.stamp = msg->header.stamp.toSec();
   {
     std::lock_guard<std::mutex> lock(input_mutex_);
     if (imu_.size() >= kMaxQueuedImu) imu_.pop_front();
-    imu_.push_back(msg);
+    imu_.push_back(sample);
   }
   input_cv_.notify_all();
+}
+
+bool LaserOdometry::imuValueInBase(const sensor_msgs::Imu& msg, double* value) {
+  geometry_msgs::Quaternion mount;
+  if (!imuMount(stripLeadingSlash(msg.header.frame_id), &mount)) return false;
+  std::string error;
+  if (!imuValueFromMsg(msg, mount, options_.tracker.imu.use_orientation, value, &error)) {
+    warnThrottled("imu_bad", "IMU sample on " + imu_sub_.getTopic() + " ignored: " + error, 10.0);
+    return false;
+  }
+  return true;
+}
+
+bool LaserOdometry::imuMount(const std::string& frame, geometry_msgs::Quaternion* rotation) {
+  std::lock_guard<std::mutex> lock(imu_mount_mutex_);
+  const auto known = imu_mounts_.find(frame);
+  if (known != imu_mounts_.end()) {
+    *rotation = known->second;
+    return true;
+  }
+  geometry_msgs::Quaternion found;
+  found.w = 1.0;
+  if (frame.empty() && !warned_imu_frame_) {
+    warned_imu_frame_ = true;
+    ROS_WARN_STREAM("[" << name_ << "] IMU messages on " << imu_sub_.getTopic()
+                        << " carry no frame_id; assuming the IMU is aligned with " << options_.base_frame);
+  } else if (!frame.empty() && frame != options_.base_frame) {
+    const ros::WallTime now = ros::WallTime::now();
+    if (now < imu_tf_retry_) return false;
+    try {
+      found = tf_buffer_.lookupTransform(options_.base_frame, frame, ros::Time(0)).transform.rotation;
+    } catch (const tf2::TransformException& ex) {
+      imu_tf_retry_ = now + ros::WallDuration(kTfRetrySeconds);
+      warnThrottled("imu_tf",
+                    "IMU samples dropped: no transform " + options_.base_frame + " -> " + frame +
+                        " (base_frame -> the IMU's frame_id) on tf yet (" + ex.what() + ")",
+                    options_.tf_warn_period);
+      return false;
+    }
+  }
+  imu_mounts_.emplace(frame, found);
+  *rotation = found;
+  return true;
 }
 
 bool LaserOdometry::resetCallback(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
@@ -224,36 +271,8 @@ void LaserOdometry::takeQueuedInputs() {
     pipeline_.addOdometry(sample.stamp, sample.pose);
   }
   odometry_.clear();
-  for (const sensor_msgs::ImuConstPtr& msg : imu_) addImu(*msg);
+  for (const ImuSample& sample : imu_) pipeline_.addImu(sample.stamp, sample.value);
   imu_.clear();
-}
-
-void LaserOdometry::addImu(const sensor_msgs::Imu& msg) {
-  const std::string frame = stripLeadingSlash(msg.header.frame_id);
-  auto mount = imu_mounts_.find(frame);
-  if (mount == imu_mounts_.end()) {
-    geometry_msgs::Quaternion rotation;
-    rotation.w = 1.0;  // an IMU without a frame_id, or in base_frame itself
-    if (!frame.empty() && frame != options_.base_frame) {
-      try {
-        rotation = tf_buffer_.lookupTransform(options_.base_frame, frame, ros::Time(0)).transform.rotation;
-      } catch (const tf2::TransformException& ex) {
-        warnThrottled("imu_tf",
-                      "IMU samples dropped: no transform " + options_.base_frame + " -> " + frame +
-                          " (base_frame -> the IMU's frame_id) on tf yet (" + ex.what() + ")",
-                      options_.tf_warn_period);
-        return;
-      }
-    }
-    mount = imu_mounts_.emplace(frame, rotation).first;
-  }
-  double value = 0.0;
-  std::string error;
-  if (!imuValueFromMsg(msg, mount->second, options_.tracker.imu.use_orientation, &value, &error)) {
-    warnThrottled("imu_bad", "IMU sample on " + imu_sub_.getTopic() + " ignored: " + error, 10.0);
-    return;
-  }
-  pipeline_.addImu(msg.header.stamp.toSec(), value);
 }
 
 void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
@@ -264,7 +283,9 @@ void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
          << update.tracker.stamp << " s (missing, or a gap longer than imu/max_gap "
          << options_.tracker.imu.max_gap << " s); the rotation is predicted from "
          << (update.tracker.prediction == hglasm::PredictionSource::kOdometry ? "the wheel odometry"
-                                                                              : "the recent motion")
+             : update.tracker.prediction == hglasm::PredictionSource::kConstantVelocity
+                 ? "the recent motion"
+                 : "nothing (no motion known yet)")
          << " until it returns";
     ROS_WARN_STREAM("[" << name_ << "] " << text.str());
   } else {
@@ -275,7 +296,7 @@ void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
   imu_stale_ = update.imu_stale;
 }
 
-bool LaserOdometry::waitForOdometry(double stamp) {
+bool LaserOdometry::waitForInputs(double stamp) {
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                              std::chrono::duration<double>(options_.odometry_wait));
@@ -283,11 +304,11 @@ bool LaserOdometry::waitForOdometry(double stamp) {
   while (true) {
     takeQueuedInputs();
     if (stop_) return false;
-    if (pipeline_.odometryReadyFor(stamp)) return true;
+    if (pipeline_.inputsReadyFor(stamp)) return true;
     if (input_cv_.wait_until(lock, deadline) == std::cv_status::timeout) {
       takeQueuedInputs();
       // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
-      pipeline_.odometryWaitTimedOut(stamp);
+      pipeline_.inputsWaitTimedOut(stamp);
       return !stop_;
     }
   }
@@ -382,7 +403,7 @@ void LaserOdometry::workerLoop() {
       if (stop_) return;
       continue;
     }
-    if (!waitForOdometry(msg->header.stamp.toSec())) return;
+    if (!waitForInputs(msg->header.stamp.toSec())) return;
     processScan(*msg);
   }
 }

@@ -339,7 +339,7 @@ void visitPredictionOptions(Params& tree, LaserOdometryOptions* options) {
   tree.boolean("imu/use_orientation", &imu.use_orientation);
   tree.number("imu/max_gap", &imu.max_gap, 0.0, 10.0, true);
   tree.nonNegativeNumber("imu/noise/angle_random_walk", &imu.angle_random_walk);
-  tree.nonNegativeNumber("imu/noise/bias", &imu.bias);
+  tree.nonNegativeNumber("imu/noise/bias_sigma", &imu.bias_sigma);
   tree.nonNegativeNumber("imu/noise/scale_error", &imu.scale_error);
   tree.boolean("imu/noise/estimate_bias", &imu.estimate_bias);
   tree.nonNegativeNumber("imu/noise/bias_random_walk", &imu.bias_random_walk);

@@ -45,24 +45,24 @@ hglasm::RangeScan rangesAt(const Pose2D& laser_pose, bool upside_down,
 
 TEST(OdometryPipeline, WaitsForOdometryAtOrAfterTheScan) {
   OdometryPipeline pipeline;
-  EXPECT_TRUE(pipeline.odometryReadyFor(1.0)) << "no odometry yet: nothing to wait for";
+  EXPECT_TRUE(pipeline.inputsReadyFor(1.0)) << "no odometry yet: nothing to wait for";
   EXPECT_EQ(pipeline.newestOdometryStamp(), -std::numeric_limits<double>::infinity());
   ASSERT_TRUE(pipeline.addOdometry(0.9, Pose2D()));
-  EXPECT_FALSE(pipeline.odometryReadyFor(1.0)) << "the sample after the scan is still to come";
+  EXPECT_FALSE(pipeline.inputsReadyFor(1.0)) << "the sample after the scan is still to come";
   ASSERT_TRUE(pipeline.addOdometry(1.0, Pose2D()));
-  EXPECT_TRUE(pipeline.odometryReadyFor(1.0)) << "a sample at the scan's stamp";
-  EXPECT_FALSE(pipeline.odometryReadyFor(1.05));
-  EXPECT_FALSE(pipeline.odometryReadyFor(5.0)) << "old odometry is waited for: a gap in the data, not a stop";
-  pipeline.odometryWaitTimedOut(5.0);
+  EXPECT_TRUE(pipeline.inputsReadyFor(1.0)) << "a sample at the scan's stamp";
+  EXPECT_FALSE(pipeline.inputsReadyFor(1.05));
+  EXPECT_FALSE(pipeline.inputsReadyFor(5.0)) << "old odometry is waited for: a gap in the data, not a stop";
+  pipeline.inputsWaitTimedOut(5.0);
   EXPECT_TRUE(pipeline.odometryStalled());
-  EXPECT_TRUE(pipeline.odometryReadyFor(5.0)) << "after a wait timed out, odometry counts as stalled";
+  EXPECT_TRUE(pipeline.inputsReadyFor(5.0)) << "after a wait timed out, odometry counts as stalled";
   EXPECT_FALSE(pipeline.addOdometry(std::nan(""), Pose2D()));
   EXPECT_FALSE(pipeline.addOdometry(2.0, Pose2D(std::nan(""), 0.0, 0.0)));
   EXPECT_EQ(pipeline.newestOdometryStamp(), 1.0) << "rejected samples do not count";
   EXPECT_TRUE(pipeline.odometryStalled()) << "rejected samples do not revive it either";
   ASSERT_TRUE(pipeline.addOdometry(1.1, Pose2D()));
   EXPECT_FALSE(pipeline.odometryStalled()) << "a new sample: it moves again";
-  EXPECT_FALSE(pipeline.odometryReadyFor(5.0));
+  EXPECT_FALSE(pipeline.inputsReadyFor(5.0));
   ASSERT_TRUE(pipeline.addOdometry(0.5, Pose2D()));
   EXPECT_EQ(pipeline.newestOdometryStamp(), 1.1) << "a late, older sample does not move the newest stamp";
 }
@@ -72,10 +72,10 @@ TEST(OdometryPipeline, NeverWaitsWhenOdometryIsOffOrWaitingDisabled) {
   no_odometry.use_odometry = false;
   OdometryPipeline off(no_odometry);
   off.addOdometry(0.9, Pose2D());
-  EXPECT_TRUE(off.odometryReadyFor(1.0));
+  EXPECT_TRUE(off.inputsReadyFor(1.0));
   OdometryPipeline no_wait(TrackerOptions(), false);
   no_wait.addOdometry(0.9, Pose2D());
-  EXPECT_TRUE(no_wait.odometryReadyFor(1.0));
+  EXPECT_TRUE(no_wait.inputsReadyFor(1.0));
 }
 
 TEST(OdometryPipeline, WithUseImuTheImuIsWaitedForAndStallsOnItsOwn) {
@@ -83,21 +83,21 @@ TEST(OdometryPipeline, WithUseImuTheImuIsWaitedForAndStallsOnItsOwn) {
   options.use_imu = true;
   OdometryPipeline pipeline(options);
   ASSERT_TRUE(pipeline.addOdometry(1.0, Pose2D()));
-  EXPECT_TRUE(pipeline.odometryReadyFor(1.0)) << "no IMU sample yet: nothing to wait for";
+  EXPECT_TRUE(pipeline.inputsReadyFor(1.0)) << "no IMU sample yet: nothing to wait for";
   ASSERT_TRUE(pipeline.addImu(0.95, 0.0));
-  EXPECT_FALSE(pipeline.odometryReadyFor(1.0)) << "the wheels are there, the IMU's sample is still to come";
+  EXPECT_FALSE(pipeline.inputsReadyFor(1.0)) << "the wheels are there, the IMU's sample is still to come";
   ASSERT_TRUE(pipeline.addImu(1.0, 0.0));
-  EXPECT_TRUE(pipeline.odometryReadyFor(1.0));
+  EXPECT_TRUE(pipeline.inputsReadyFor(1.0));
   ASSERT_TRUE(pipeline.addOdometry(2.0, Pose2D()));
-  pipeline.odometryWaitTimedOut(2.0);
+  pipeline.inputsWaitTimedOut(2.0);
   EXPECT_TRUE(pipeline.imuStalled());
   EXPECT_FALSE(pipeline.odometryStalled()) << "the wheels had their sample";
-  EXPECT_TRUE(pipeline.odometryReadyFor(2.0));
+  EXPECT_TRUE(pipeline.inputsReadyFor(2.0));
   EXPECT_FALSE(pipeline.addImu(std::nan(""), 0.0));
   EXPECT_TRUE(pipeline.imuStalled()) << "a rejected sample does not revive it";
   ASSERT_TRUE(pipeline.addImu(1.5, 0.0));
   EXPECT_FALSE(pipeline.imuStalled());
-  EXPECT_FALSE(pipeline.odometryReadyFor(2.0));
+  EXPECT_FALSE(pipeline.inputsReadyFor(2.0));
 }
 
 TEST(OdometryPipeline, ReplayAddsWhatTheLiveNodeHoldsAfterItsWait) {
@@ -115,7 +115,7 @@ TEST(OdometryPipeline, ReplayAddsWhatTheLiveNodeHoldsAfterItsWait) {
   // within its wait does: the scan's prediction is interpolated across the gap.
   next = pipeline.addRecordedOdometry(next, samples.end(), 2.5);
   EXPECT_EQ(next - samples.begin(), 6);
-  EXPECT_TRUE(pipeline.odometryReadyFor(2.5));
+  EXPECT_TRUE(pipeline.inputsReadyFor(2.5));
 
   TrackerOptions no_odometry;
   no_odometry.use_odometry = false;
@@ -169,21 +169,46 @@ TEST(OdometryPipeline, ImuStalenessChangesAreReportedOnce) {
   options.use_imu = true;
   OdometryPipeline pipeline(options);
   const hglasm::RangeScan scan = rangesAt(Pose2D(), false);
-  // The IMU covers 0.1-0.32 s and 0.58-0.8 s at 200 Hz; scans every 0.1 s from 0.1 s (the first starts the
-  // odometry).
-  for (int i = 20; i <= 64; ++i) ASSERT_TRUE(pipeline.addImu(0.005 * i, 0.0));
-  for (int i = 116; i <= 160; ++i) ASSERT_TRUE(pipeline.addImu(0.005 * i, 0.0));
-  EXPECT_FALSE(pipeline.addImu(std::nan(""), 0.0));
+  // The IMU sends at 200 Hz during 0.1-0.32 s and 0.58-0.8 s; as live, each scan (every 0.1 s from 0.1 s,
+  // the first starts the odometry) comes after the samples stamped up to it.
+  const auto sent = [](int i) { return (i >= 20 && i <= 64) || (i >= 116 && i <= 160); };
+  int next = 0;
   std::vector<bool> stale, changed;
-  for (int i = 1; i <= 8; ++i) {
-    const PipelineUpdate update = pipeline.processScan(0.1 * i, scan);
+  for (int k = 1; k <= 8; ++k) {
+    for (; next <= 20 * k; ++next) {
+      if (sent(next)) {
+        ASSERT_TRUE(pipeline.addImu(0.005 * next, 0.0));
+      }
+    }
+    const PipelineUpdate update = pipeline.processScan(0.1 * k, scan);
     stale.push_back(update.imu_stale);
     changed.push_back(update.imu_stale_changed);
   }
-  // 0.1: the start; 0.2, 0.3: covered; 0.4 (0.08 s past the last sample is within max_gap); 0.5, 0.6: the
-  // 0.32-0.58 gap; 0.7, 0.8: covered again.
-  EXPECT_EQ(stale, std::vector<bool>({false, false, false, true, true, true, false, false}));
-  EXPECT_EQ(changed, std::vector<bool>({false, false, false, true, false, false, true, false}));
+  EXPECT_FALSE(pipeline.addImu(std::nan(""), 0.0));
+  // 0.2, 0.3: covered; 0.4: 0.08 s past the last sample, within max_gap; 0.5, 0.6: the gap 0.32-0.58 lies
+  // in their steps; 0.7, 0.8: covered again.
+  EXPECT_EQ(stale, std::vector<bool>({false, false, false, false, true, true, false, false}));
+  EXPECT_EQ(changed, std::vector<bool>({false, false, false, false, true, false, true, false}));
+}
+
+TEST(OdometryPipeline, AStalledInputIsRevivedOnlyBySamplesAtOrAfterTheLastScan) {
+  // An IMU whose samples lag by more than the live wait is not waited for at every scan.
+  TrackerOptions options;
+  options.use_odometry = false;
+  options.use_imu = true;
+  OdometryPipeline pipeline(options);
+  const hglasm::RangeScan scan = rangesAt(Pose2D(), false);
+  ASSERT_TRUE(pipeline.addImu(0.5, 0.0));
+  ASSERT_FALSE(pipeline.inputsReadyFor(1.0));
+  pipeline.inputsWaitTimedOut(1.0);
+  EXPECT_TRUE(pipeline.imuStalled());
+  pipeline.processScan(1.0, scan);
+  ASSERT_TRUE(pipeline.addImu(0.8, 0.0));  // late: older than the scan already processed
+  EXPECT_TRUE(pipeline.imuStalled());
+  EXPECT_TRUE(pipeline.inputsReadyFor(1.1)) << "not waited for";
+  ASSERT_TRUE(pipeline.addImu(1.0, 0.0));  // caught up with the scans
+  EXPECT_FALSE(pipeline.imuStalled());
+  EXPECT_FALSE(pipeline.inputsReadyFor(1.1));
 }
 
 TEST(OdometryPipeline, WithoutUseImuNothingIsStale) {
@@ -194,7 +219,7 @@ TEST(OdometryPipeline, WithoutUseImuNothingIsStale) {
     const PipelineUpdate update = pipeline.processScan(0.1 * i, scan);
     EXPECT_FALSE(update.imu_stale);
     EXPECT_FALSE(update.imu_stale_changed);
-    EXPECT_FALSE(update.tracker.imu_rotation);
+    EXPECT_FALSE(update.tracker.rotation_from_imu);
   }
 }
 

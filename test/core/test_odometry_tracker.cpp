@@ -602,7 +602,7 @@ struct FastTurnRun {
   double translation_error = 0.0;  ///< of the final pose, m
   double rotation_error = 0.0;     ///< of the final pose, rad
   double worst_rotation_error = 0.0;
-  int fallbacks = 0, leaps = 0, imu_rotations = 0, scans = 0;
+  int fallbacks = 0, leaps = 0, rotations_from_imu = 0, scans = 0;
   double learned_bias = 0.0;  ///< the tracker's gyro bias at the end, rad/s
 };
 
@@ -626,7 +626,7 @@ FastTurnRun runFastTurns(bool use_imu, double turn_rate, double scan_rate, doubl
     expectSane(update);
     run.fallbacks += update.fallback;
     run.leaps += update.leap;
-    run.imu_rotations += update.imu_rotation;
+    run.rotations_from_imu += update.rotation_from_imu;
     run.scans += i > 0;
     run.worst_rotation_error =
         std::max(run.worst_rotation_error, hglasm_test::rotationError(update.pose, robot.truth(t)));
@@ -650,7 +650,7 @@ void printRun(const char* what, const FastTurnRun& run) {
       "%-28s final %.4f m %.3f deg, worst heading %.3f deg, leaps %d, fallbacks %d, IMU steps %d/%d, "
       "learned bias %.4f rad/s\n",
       what, run.translation_error, run.rotation_error * 180.0 / kPi, run.worst_rotation_error * 180.0 / kPi,
-      run.leaps, run.fallbacks, run.imu_rotations, run.scans, run.learned_bias);
+      run.leaps, run.fallbacks, run.rotations_from_imu, run.scans, run.learned_bias);
 }
 
 TEST(OdometryTracker, AGyroTracksFastTurnsThatTheWheelsGetWrong) {
@@ -662,13 +662,24 @@ TEST(OdometryTracker, AGyroTracksFastTurnsThatTheWheelsGetWrong) {
   printRun("5 Hz, wheels alone:", wheels);
   printRun("5 Hz, gyro:", gyro);
   EXPECT_GT(wheels.worst_rotation_error, hglasm_test::deg(10.0)) << "the scenario is not hard for the wheels";
-  EXPECT_EQ(gyro.imu_rotations, gyro.scans) << "every step's rotation from the gyro";
+  EXPECT_EQ(gyro.rotations_from_imu, gyro.scans) << "every step's rotation from the gyro";
   EXPECT_EQ(gyro.fallbacks, 0);
   EXPECT_EQ(gyro.leaps, 0);
   EXPECT_LT(gyro.translation_error, 0.01);
   EXPECT_LT(gyro.rotation_error, hglasm_test::deg(0.3));
   EXPECT_LT(gyro.worst_rotation_error, hglasm_test::deg(0.5));
   EXPECT_NEAR(gyro.learned_bias, kGyroBias, 0.005) << "the bias learned from the matches";
+}
+
+TEST(OdometryTracker, AGrosslyBiasedGyroIsLearnedInTheFirstSeconds) {
+  // 0.5 rad/s (29 deg/s), a hundred times the prior: the first steps leap, then the bias is known.
+  const FastTurnRun gyro = runFastTurns(true, kPi, 5.0, 0.3, 0.5, kGyroNoiseDensity);
+  printRun("5 Hz, gyro biased 0.5 rad/s:", gyro);
+  EXPECT_NEAR(gyro.learned_bias, 0.5, 0.005);
+  EXPECT_LE(gyro.leaps, 5);
+  EXPECT_EQ(gyro.fallbacks, 0);
+  EXPECT_LT(gyro.worst_rotation_error, hglasm_test::deg(2.0));
+  EXPECT_LT(gyro.rotation_error, hglasm_test::deg(0.3));
 }
 
 TEST(OdometryTracker, WithoutLearningTheGyroBiasTheSameRunNeedsLeaps) {
@@ -705,13 +716,13 @@ TEST(OdometryTracker, WhenTheGyroStopsTheWheelsPredictTheRotation) {
   robot.enableGyro(kGyroBias, kGyroNoiseDensity, 3);
   TrackerUpdate update;
   for (int i = 0; i <= 20; ++i) update = robot.step(0.1 * i);
-  EXPECT_TRUE(update.imu_rotation);
+  EXPECT_TRUE(update.rotation_from_imu);
   robot.disableGyro();
   for (int i = 21; i <= 40; ++i) {
     update = robot.step(0.1 * i);
     expectSane(update);
     if (i >= 23) {
-      EXPECT_FALSE(update.imu_rotation) << "scan " << i << ": the gyro stopped at 2.0 s";
+      EXPECT_FALSE(update.rotation_from_imu) << "scan " << i << ": the gyro stopped at 2.0 s";
     }
     EXPECT_EQ(update.prediction, PredictionSource::kOdometry);
   }

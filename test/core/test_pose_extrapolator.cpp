@@ -111,7 +111,7 @@ TEST(PoseExtrapolator, OdometryIgnoredWhenDisabledStaleOrCleared) {
   // The newest sample may be extrapolated 0.5 s, not 0.6 s.
   EXPECT_EQ(extrapolator.predict(0.0, 1.5, noise, &warning).source, PredictionSource::kOdometry);
   EXPECT_EQ(extrapolator.predict(0.0, 1.6, noise, &warning).source, PredictionSource::kNone);
-  extrapolator.clearOdometry();
+  extrapolator.clearSensorHistory();
   EXPECT_EQ(extrapolator.predict(0.0, 1.0, noise, &warning).source, PredictionSource::kNone);
   EXPECT_TRUE(warning.empty());
 }
@@ -119,7 +119,7 @@ TEST(PoseExtrapolator, OdometryIgnoredWhenDisabledStaleOrCleared) {
 PoseExtrapolator makeGyroExtrapolator(bool use_odometry = true) {
   hglasm::GyroOptions gyro;
   gyro.angle_random_walk = 0.01;
-  gyro.bias = 0.02;
+  gyro.bias_sigma = 0.02;
   gyro.scale_error = 0.03;
   return PoseExtrapolator(use_odometry, kOdometryAge, kMaxSpeed, kMaxTurnRate, true, gyro);
 }
@@ -137,16 +137,53 @@ TEST(PoseExtrapolator, TheGyroGivesTheRotationAndTurnsTheWheelsChordWithIt) {
   EXPECT_EQ(prediction.source, PredictionSource::kOdometry);
   EXPECT_TRUE(prediction.gyro);
   expectPose(prediction.motion, std::cos(0.2), std::sin(0.2), 0.4);
-  // Translation noise: the wheels'; heading noise: the gyro's alone, uncorrelated with it; the wheels'
-  // nominal heading variance is zero (their heading is not what was predicted, so not learned from).
-  const Eigen::Matrix3d wheels = noise.odometryCovariance(Pose2D(1.0, 0.0, 0.0), 0.5);
-  const Eigen::Matrix2d translation = prediction.covariance.topLeftCorner<2, 2>();
-  EXPECT_EQ(translation, (wheels.topLeftCorner<2, 2>()));
-  EXPECT_NEAR(prediction.covariance(2, 2), 0.01 * 0.01 * 0.5 + 0.01 * 0.01 + 0.012 * 0.012, 1e-15);
-  EXPECT_EQ(prediction.covariance(0, 2), 0.0);
-  EXPECT_EQ(prediction.covariance(2, 1), 0.0);
+  // First order: the wheels' translation noise turned with the chord (theirs is isotropic here), and the
+  // gyro's heading noise, which also moves the chord by half of it across the chord; the wheels' nominal
+  // heading variance is zero (their heading is not what was predicted, so not learned from).
+  const double heading_variance = 0.01 * 0.01 * 0.5 + 0.01 * 0.01 + 0.012 * 0.012;
+  const Eigen::Vector3d chord_per_radian(-0.5 * std::sin(0.2), 0.5 * std::cos(0.2), 1.0);
+  Eigen::Matrix3d expected = Eigen::Matrix3d::Zero();
+  expected.topLeftCorner<2, 2>() = noise.odometryCovariance(Pose2D(1.0, 0.0, 0.0), 0.5).topLeftCorner<2, 2>();
+  expected += heading_variance * chord_per_radian * chord_per_radian.transpose();
+  EXPECT_TRUE(prediction.covariance.isApprox(expected, 1e-12)) << prediction.covariance << "\n" << expected;
   EXPECT_EQ(prediction.nominal_covariance(2, 2), 0.0);
+  EXPECT_EQ(prediction.nominal_covariance(0, 2), 0.0);
   EXPECT_GT(prediction.nominal_covariance(0, 0), 0.0);
+}
+
+TEST(PoseExtrapolator, TheChordIsTurnedTheShortWayForTurnsBeyondPiAndToTheRight) {
+  // 3.3 rad in 4 s (the wheels' heading wraps to 3.3 - 2 pi, the gyro's does not): both agree, so the
+  // chord, at half the rotation, stays where the wheels put it.
+  PoseExtrapolator extrapolator = makeGyroExtrapolator();
+  extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addOdometry(4.0, Pose2D(std::cos(1.65), std::sin(1.65), 3.3));
+  for (int i = 0; i <= 400; ++i) extrapolator.addGyro(0.01 * i, 3.3 / 4.0);
+  const MotionNoiseModel noise;
+  std::string warning;
+  const MotionPrediction wide = extrapolator.predict(0.0, 4.0, noise, &warning);
+  ASSERT_TRUE(wide.gyro) << warning;
+  expectPose(wide.motion, std::cos(1.65), std::sin(1.65), 3.3, 1e-9);
+
+  // To the right: the wheels turn -0.2 rad, the gyro -0.4: the chord turns by -0.1 more.
+  PoseExtrapolator right = makeGyroExtrapolator();
+  right.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  right.addOdometry(0.5, Pose2D(std::cos(-0.1), std::sin(-0.1), -0.2));
+  for (int i = 0; i <= 50; ++i) right.addGyro(0.01 * i, -0.8);
+  const MotionPrediction turned = right.predict(0.0, 0.5, noise, &warning);
+  ASSERT_TRUE(turned.gyro);
+  expectPose(turned.motion, std::cos(-0.2), std::sin(-0.2), -0.4, 1e-9);
+}
+
+TEST(PoseExtrapolator, AnImplausiblyFastGyroIsNotUsedAndSaysSo) {
+  PoseExtrapolator extrapolator = makeGyroExtrapolator();
+  extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
+  extrapolator.addOdometry(0.5, Pose2D(1.0, 0.0, 0.1));
+  for (int i = 0; i <= 50; ++i) extrapolator.addGyro(0.01 * i, 20.0);  // 10 rad in 0.5 s: a spike
+  std::string warning;
+  const MotionPrediction prediction = extrapolator.predict(0.0, 0.5, MotionNoiseModel(), &warning);
+  EXPECT_FALSE(prediction.gyro);
+  expectPose(prediction.motion, 1.0, 0.0, 0.1);
+  EXPECT_NE(warning.find("IMU rotation"), std::string::npos) << warning;
 }
 
 TEST(PoseExtrapolator, WithoutWheelsTheGyroTurnsTheConstantVelocityPrediction) {
@@ -171,12 +208,12 @@ TEST(PoseExtrapolator, StaleOrMissingGyroLeavesTheWheelsPrediction) {
   EXPECT_FALSE(missing.gyro);
   expectPose(missing.motion, 1.0, 0.0, 0.3);
   EXPECT_EQ(missing.covariance, noise.odometryCovariance(missing.motion, 1.0));
-  for (int i = 0; i <= 50; ++i) extrapolator.addGyro(0.01 * i, 2.0);  // stops at 0.5 s
+  for (int i = 0; i <= 50; ++i) extrapolator.addGyro(0.01 * i, 1.0);  // stops at 0.5 s
   const MotionPrediction stale = extrapolator.predict(0.0, 1.0, noise, &warning);
   EXPECT_FALSE(stale.gyro);
   expectPose(stale.motion, 1.0, 0.0, 0.3);
   EXPECT_TRUE(extrapolator.predict(0.0, 0.55, noise, &warning).gyro) << "within max_gap of the newest sample";
-  extrapolator.clearOdometry();
+  extrapolator.clearSensorHistory();
   EXPECT_FALSE(extrapolator.predict(0.0, 0.5, noise, &warning).gyro) << "cleared with the odometry";
 }
 

@@ -340,7 +340,7 @@ TEST(Parameters, ImuParametersAreReadAndValidated) {
                                   {"imu/use_orientation", true},
                                   {"imu/max_gap", 0.05},
                                   {"imu/noise/angle_random_walk", 0.001},
-                                  {"imu/noise/bias", 0},
+                                  {"imu/noise/bias_sigma", 0},
                                   {"imu/noise/scale_error", 0.05},
                                   {"imu/noise/estimate_bias", false},
                                   {"imu/noise/bias_random_walk", 0.001}}),
@@ -350,15 +350,15 @@ TEST(Parameters, ImuParametersAreReadAndValidated) {
   EXPECT_TRUE(options.tracker.imu.use_orientation);
   EXPECT_EQ(options.tracker.imu.max_gap, 0.05);
   EXPECT_EQ(options.tracker.imu.angle_random_walk, 0.001);
-  EXPECT_EQ(options.tracker.imu.bias, 0.0);
+  EXPECT_EQ(options.tracker.imu.bias_sigma, 0.0);
   EXPECT_EQ(options.tracker.imu.scale_error, 0.05);
   EXPECT_FALSE(options.tracker.imu.estimate_bias);
   EXPECT_EQ(options.tracker.imu.bias_random_walk, 0.001);
   EXPECT_NE(summarize(options).find("IMU orientation in"), std::string::npos) << summarize(options);
   EXPECT_EQ(loadError(params({{"imu/max_gap", 0.0}})),
             "parameter ~imu/max_gap must be a number in [0, 10] and > 0, got 0");
-  EXPECT_EQ(loadError(params({{"imu/noise/bias", -0.1}})),
-            "parameter ~imu/noise/bias must be a non-negative number, got -0.1");
+  EXPECT_EQ(loadError(params({{"imu/noise/bias_sigma", -0.1}})),
+            "parameter ~imu/noise/bias_sigma must be a non-negative number, got -0.1");
   EXPECT_NE(loadError(params({{"use_imu", "yes"}})).find("~use_imu must be true or false"),
             std::string::npos);
 }

@@ -2,6 +2,7 @@
 // its yaw; how far that rotation may be off; and the gyro's bias, learned from the scan matches.
 #pragma once
 
+#include <cstddef>
 #include <deque>
 
 namespace hglasm {
@@ -16,9 +17,9 @@ struct GyroOptions {
   /// The rotation's noise: white rate noise (angle random walk, rad per sqrt(s); 0.002 is 0.11 deg/s per
   /// sqrt(Hz), ten times a consumer MEMS gyro's datasheet figure, for a robot's vibration); ...
   double angle_random_walk = 0.002;
-  /// ... an unknown bias (standard deviation, rad/s), whose error grows with the interval, until the
-  /// matches have taught its value (estimate_bias); ...
-  double bias = 0.005;
+  /// ... an unknown bias, of this standard deviation (rad/s) before the matches have taught its value
+  /// (estimate_bias); its error grows with the interval; ...
+  double bias_sigma = 0.005;
   /// ... and an error proportional to the rotation (scale factor, and stamps of the IMU and the laser a
   /// few milliseconds apart): the fraction of the rotation it reaches (standard deviation).
   double scale_error = 0.02;
@@ -29,7 +30,7 @@ struct GyroOptions {
 };
 
 /// Variance (rad^2) of a gyro rotation of `angle` radians over `dt` seconds under `options`' noise model,
-/// with a bias known to `bias_variance` ((rad/s)^2; options.bias squared before anything is learned).
+/// with a bias known to `bias_variance` ((rad/s)^2; bias_sigma squared before anything is learned).
 double gyroRotationVariance(const GyroOptions& options, double angle, double dt, double bias_variance);
 
 /// The gyro's bias as a scalar Kalman filter: a random walk (bias_random_walk) observed by each matched
@@ -38,24 +39,36 @@ class GyroBiasEstimator {
  public:
   explicit GyroBiasEstimator(const GyroOptions& options = {});
 
-  /// One step of `dt` s: `predicted` is the IMU's rotation corrected by bias() (as the prediction used it),
-  /// `measured` the scans' rotation over the same step, with variance `measured_variance`. A difference
-  /// beyond kGate standard deviations of what the filter expects counts as kGate (a bad match moves the
-  /// estimate a little, a real bias far outside the prior is still learned, step by step). Ignored (false)
-  /// without estimate_bias or for non-finite or non-positive input.
-  bool update(double predicted, double measured, double measured_variance, double dt);
+  /// One step of `dt` s ending at `stamp`: `predicted` is the IMU's rotation corrected by bias() (as the
+  /// prediction used it), `measured` the scans' rotation over the same step, with variance
+  /// `measured_variance`. The bias wanders over the whole time since the previous update (the IMU may
+  /// have been stale, matches may have failed). A difference beyond kGate standard deviations of what the
+  /// filter expects counts as kGate, so one bad match moves the estimate little. Differences that keep
+  /// leaning one way (a bias that changed faster than the model allows) widen the variance, and the
+  /// estimate follows within a few steps. Ignored (false) without estimate_bias, or for non-finite,
+  /// negative or zero-length input.
+  bool update(double predicted, double measured, double measured_variance, double dt, double stamp);
 
   double bias() const { return bias_; }          ///< rad/s
   double variance() const { return variance_; }  ///< (rad/s)^2
-  /// Back to no knowledge: zero with options.bias's variance.
+  /// Back to no knowledge: zero with bias_sigma's variance.
   void reset();
 
   static constexpr double kGate = 4.0;
+  /// The innovations' running mean (in standard deviations) over about kInnovationMemory steps: under
+  /// the model its standard deviation is 0.23, so beyond kDriftSigmas (5.4 of those) it is a drift, not
+  /// noise: none in 10^5 steps of noise alone.
+  static constexpr double kInnovationMemory = 10.0;
+  static constexpr double kDriftSigmas = 1.25;
 
  private:
   GyroOptions options_;
   double bias_ = 0.0;
   double variance_ = 0.0;
+  double last_stamp_ = 0.0;
+  bool have_stamp_ = false;
+  double mean_sigmas_ = 0.0;      // running mean of the innovations in standard deviations
+  double mean_bias_error_ = 0.0;  // running mean of innovation / dt: the bias error they show, rad/s
 };
 
 /// A short history of IMU samples: the base's yaw rate (rad/s), or its yaw (rad) when
@@ -69,23 +82,29 @@ class GyroBuffer {
 
   /// The rotation of the base from `from` to `to` (from <= to): the rate integrated along its linear
   /// interpolation between samples (held beyond the ends), or the yaw at `to` minus the yaw at `from`
-  /// along the samples between (so several turns between two scans count). False when the samples do not
-  /// cover the interval: a gap longer than max_gap, or an end farther than max_gap beyond the samples.
+  /// along the samples between (so several turns between two scans count; beyond the ends the yaw goes on
+  /// at the end segment's rate). False when the samples do not cover the interval: a gap longer than
+  /// max_gap, or an end farther than max_gap beyond the samples.
   bool rotation(double from, double to, double* angle) const;
+
+  /// Drops the samples before `stamp` (all but the last of them: it bounds the next interval). Callers
+  /// prune behind the scans they process, not behind the newest sample: one sample stamped far in the
+  /// future must not evict the rest.
+  void forgetBefore(double stamp);
 
   void clear() { samples_.clear(); }
   bool empty() const { return samples_.empty(); }
   const GyroOptions& options() const { return options_; }
 
-  static constexpr double kKeptSeconds = 10.0;  // history kept behind the newest sample
+  static constexpr std::size_t kMaxSamples = 20000;  // 20 s at 1 kHz: a bound if nobody prunes
 
  private:
   struct Sample {
     double stamp;
     double value;
   };
-  /// The value at `stamp`, linear between the samples around it (yaw along the shorter arc), the end
-  /// sample's beyond them.
+  /// The value at `stamp`, linear between the samples around it (yaw along the shorter arc); beyond them
+  /// the end sample's rate, or the yaw extrapolated along the end segment.
   double valueAt(double stamp) const;
 
   GyroOptions options_;

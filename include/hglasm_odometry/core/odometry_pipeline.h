@@ -45,11 +45,11 @@ struct PipelineUpdate {
 /// nothing.
 ///
 /// Wheel-odometry feeding policy (both the live node and offline replays obey it, so the tracker sees
-/// the same samples around every scan): a scan stamped t is processed once odometryReadyFor(t), i.e.
+/// the same samples around every scan): a scan stamped t is processed once inputsReadyFor(t), i.e.
 /// once a sample stamped at or after t has been added, so the prediction at t is interpolated between
 /// the two samples around it, never extrapolated, even across a gap in the data. It is not waited for
 /// when odometry is off, when none has been added yet, or while odometry is stalled: a live node bounds
-/// each wait in wall time (odometry/wait) and reports a wait that timed out (odometryWaitTimedOut());
+/// each wait in wall time (odometry/wait) and reports a wait that timed out (inputsWaitTimedOut());
 /// scans then go on without waiting until the next sample arrives. Samples added beyond the first one
 /// at or after t change nothing: interpolation only uses the two around t. With use_imu the IMU's samples
 /// are waited for the same way, and stall on their own.
@@ -74,17 +74,18 @@ class OdometryPipeline {
   double newestOdometryStamp() const { return newest_odometry_stamp_; }
 
   /// The feeding policy (see the class comment): true once a scan stamped `stamp` may be processed.
-  bool odometryReadyFor(double stamp) const;
+  bool inputsReadyFor(double stamp) const;
 
   /// A live wait for a scan at `stamp` timed out: the wheel odometry, the IMU or both (whichever had no
-  /// sample at or after it) count as stalled until their next sample arrives.
-  void odometryWaitTimedOut(double stamp);
+  /// sample at or after it) count as stalled until a sample of theirs arrives stamped at or after the
+  /// newest scan processed: one that lags by more than the wait is not waited for at every scan.
+  void inputsWaitTimedOut(double stamp);
   bool odometryStalled() const { return odometry_stalled_; }
   bool imuStalled() const { return imu_stalled_; }
 
   /// Offline replay of recorded odometry, under the feeding policy: adds the samples [next, end) (sorted
   /// by stamp; each with .stamp and .pose) that a live node holds when it processes a scan at `stamp`:
-  /// every sample stamped at or before it, then later ones until odometryReadyFor(stamp). Returns the
+  /// every sample stamped at or before it, then later ones until inputsReadyFor(stamp). Returns the
   /// first sample not added. Adds nothing when odometry is off. Assumes no live wait timed out; and a
   /// sample stamped exactly at `stamp` may round an ulp differently from a live buffer that already holds a
   /// later one (OdometryBuffer extrapolates by 0 s there instead of interpolating).
@@ -92,7 +93,7 @@ class OdometryPipeline {
   Iterator addRecordedOdometry(Iterator next, Iterator end, double stamp) {
     if (!tracker_.options().use_odometry) return end;
     for (; next != end && next->stamp <= stamp; ++next) addOdometry(next->stamp, next->pose);
-    for (; next != end && !odometryReadyFor(stamp); ++next) addOdometry(next->stamp, next->pose);
+    for (; next != end && !inputsReadyFor(stamp); ++next) addOdometry(next->stamp, next->pose);
     return next;
   }
 
@@ -121,12 +122,13 @@ class OdometryPipeline {
   std::string checkGeometry(const RangeScan& ranges);
 
   OdometryTracker tracker_;
-  bool wait_for_odometry_;
+  bool wait_for_inputs_;
   ScanConversionOptions conversion_;
   Pose2D base_to_laser_;
   double newest_odometry_stamp_ = -std::numeric_limits<double>::infinity();
   bool odometry_stalled_ = false;
   double newest_imu_stamp_ = -std::numeric_limits<double>::infinity();
+  double last_scan_stamp_ = -std::numeric_limits<double>::infinity();  // of the last scan processed
   bool imu_stalled_ = false;
   bool wheelsReadyFor(double stamp) const;
   bool imuReadyFor(double stamp) const;

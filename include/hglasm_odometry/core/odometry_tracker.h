@@ -103,9 +103,10 @@ struct TrackerUpdate {
   double fitness_ratio = 0.0;
   Pose2D guess;  ///< predicted pose of the base (odometry frame) before matching
   PredictionSource prediction = PredictionSource::kNone;
-  bool imu_rotation = false;  ///< the predicted rotation came from the IMU (use_imu and it covered the step)
-  double imu_bias = 0.0;      ///< rad/s: the gyro's bias learned so far (subtracted from its rotations)
-  SearchEffort search;        ///< box and GA size the scan was searched with
+  bool rotation_from_imu =
+      false;              ///< the predicted rotation came from the IMU (use_imu and it covered the step)
+  double imu_bias = 0.0;  ///< rad/s: the gyro's bias learned so far (subtracted from its rotations)
+  SearchEffort search;    ///< box and GA size the scan was searched with
   double prior_mahalanobis = 0.0;   ///< Mahalanobis distance of the match from the prediction
   bool matched = false;             ///< a match was attempted (false for the first scan and after resets)
   bool fallback = false;            ///< match failed: the prediction was integrated instead
@@ -222,8 +223,9 @@ class OdometryTracker {
   const LookupTable& judgingTable() const { return own_table_ ? *own_table_ : matcher_.table(); }
   /// log of the normal density of `pose` under a prior.
   static double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3d& covariance);
-  /// Learns the wheels' noise and the gyro's bias from their increments against the scans' own.
-  void learnNoise(const MotionPrediction& prediction, const MatchResult& match);
+  /// Learns the wheels' noise (if `learn_wheels`) and the gyro's bias from their increments against the
+  /// scans' own.
+  void learnNoise(const MotionPrediction& prediction, const MatchResult& match, bool learn_wheels);
   Estimate integratePrediction(const MotionPrediction& prediction) const;
   void updateVelocity(double stamp, const Pose2D& new_pose, TrackerUpdate* update);
   void updateKeyframe(const Scan& scan, bool usable, TrackerUpdate* update);
@@ -258,9 +260,9 @@ class OdometryTracker {
     void add(double value);
   };
   RunningStats fitness_;              // of accepted matches: how well scans usually fit the map
-  bool have_scan_only_pose_ = false;  // and the last scan's prediction came from the wheels
-  bool have_scan_rotation_ = false;   // the last scan alone gave a usable pose
   Pose2D scan_only_pose_;             // base pose in the odometry frame where the last scan alone put it
+  bool have_scan_rotation_ = false;   // scan_only_pose_ is usable (the gyro's bias learns from it)
+  bool have_scan_only_pose_ = false;  // ... and the wheels predicted that scan (their noise learns from it)
 
   int keyframe_id_ = 0;
 };

@@ -51,15 +51,17 @@ class PoseExtrapolator {
     gyro_bias_ = bias;
     gyro_bias_variance_ = variance;
   }
+  /// Drops the IMU samples before `stamp` (GyroBuffer::forgetBefore).
+  void forgetGyroBefore(double stamp) { gyro_.forgetBefore(stamp); }
   /// Forgets the wheel odometry and the IMU samples (they belong to another timeline, e.g. time went
   /// back).
-  void clearOdometry() {
+  void clearSensorHistory() {
     odometry_.clear();
     gyro_.clear();
   }
 
   /// The motion of the base from `from` to `to`, with `noise`'s covariance. Sets *warning when the wheels
-  /// jumped (the velocity predicts instead).
+  /// jumped (the velocity predicts instead) or the IMU turned implausibly fast (it is not used).
   MotionPrediction predict(double from, double to, const MotionNoiseModel& noise, std::string* warning) const;
 
   /// A new estimate of the base pose. The velocity becomes the motion over the last kVelocityBaseline
@@ -83,8 +85,9 @@ class PoseExtrapolator {
   /// The wheels' or the velocity's prediction.
   MotionPrediction predictTranslation(double from, double to, const MotionNoiseModel& noise,
                                       std::string* warning) const;
-  /// Replaces the prediction's rotation by the IMU's, if it covers [from, to].
-  void applyGyro(double from, double to, MotionPrediction* prediction) const;
+  /// Replaces the prediction's rotation by the IMU's, if it covers [from, to] and turns plausibly (else
+  /// sets *warning).
+  void applyGyro(double from, double to, MotionPrediction* prediction, std::string* warning) const;
 
   bool use_odometry_;
   double max_odometry_age_;

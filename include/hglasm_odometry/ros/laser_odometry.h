@@ -87,12 +87,15 @@ class LaserOdometry {
   /// Waits (bounded by options_.odometry_wait) until the pipeline's feeding policy lets a scan at `stamp`
   /// be processed (wheel odometry at or after it has arrived, or none is to be expected). False if the
   /// worker is to stop.
-  bool waitForOdometry(double stamp);
+  bool waitForInputs(double stamp);
   /// Looks up base -> laser for `laser_frame` (cached); false while tf does not have it yet.
   bool ensureLaserMount(const std::string& laser_frame);
-  /// Hands one IMU message to the pipeline, rotated into base_frame (base -> its frame cached from tf);
-  /// dropped with a throttled warning while tf lacks it or the message is unusable. Worker only.
-  void addImu(const sensor_msgs::Imu& msg);
+  /// What the pipeline takes from an IMU message: the base's yaw rate (or yaw), rotated into base_frame.
+  /// False, with a throttled warning, while tf lacks base -> the IMU's frame or for an unusable message.
+  bool imuValueInBase(const sensor_msgs::Imu& msg, double* value);
+  /// base -> `frame` rotation, cached per frame (a static mount); tf is asked at most every
+  /// kTfRetrySeconds while it lacks it.
+  bool imuMount(const std::string& frame, geometry_msgs::Quaternion* rotation);
   /// Logs once when the IMU stops covering the steps between scans and once when it is back.
   void reportImuState(const hglasm::PipelineUpdate& update);
   void processScan(const sensor_msgs::LaserScan& msg);
@@ -118,7 +121,11 @@ class LaserOdometry {
   std::condition_variable input_cv_;
   std::deque<sensor_msgs::LaserScanConstPtr> scans_;  // bounded by options_.queue_size
   std::deque<OdometrySample> odometry_;
-  std::deque<sensor_msgs::ImuConstPtr> imu_;
+  struct ImuSample {
+    double stamp = 0.0;
+    double value = 0.0;  // the base's yaw rate, or yaw with imu/use_orientation
+  };
+  std::deque<ImuSample> imu_;
   std::uint32_t dropped_scans_ = 0;
   bool reset_requested_ = false;
   std::optional<PoseRequest> pose_requested_;  // a reset request clears it, and it a reset request
@@ -132,7 +139,6 @@ class LaserOdometry {
   bool local_map_sent_ = false;
   std::uint64_t local_map_revision_ = 0;  // hglasm::LocalMap::revision() of the last ~local_map sent
   bool warned_odom_child_frame_ = false;
-  std::map<std::string, geometry_msgs::Quaternion> imu_mounts_;  // base -> IMU frame rotation, per frame_id
 
   // Diagnostics (guarded by stats_mutex_).
   std::mutex stats_mutex_;
@@ -151,6 +157,12 @@ class LaserOdometry {
   // by log_mutex_ (the odometry callback and the worker both warn).
   std::mutex log_mutex_;
   std::map<std::string, ros::WallTime> last_warning_;
+
+  // The IMU's mounts, converted in its callback (any spinner thread).
+  std::mutex imu_mount_mutex_;
+  std::map<std::string, geometry_msgs::Quaternion> imu_mounts_;  // base -> IMU frame rotation, per frame_id
+  ros::WallTime imu_tf_retry_;                                   // no tf lookup before this
+  bool warned_imu_frame_ = false;
 
   // Set by ~local_map's connect callback (a spinner thread), taken by the worker: send the map again.
   std::atomic<bool> local_map_resend_{false};
