@@ -2,6 +2,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <sstream>
@@ -66,13 +67,13 @@ bool OdometryPipeline::imuReadyFor(double stamp) const {
   return imu_stalled_ || newest_imu_stamp_ >= stamp;
 }
 
-bool OdometryPipeline::inputsReadyFor(double stamp) const {
-  return wheelsReadyFor(stamp) && imuReadyFor(stamp);
+bool OdometryPipeline::inputsReadyFor(double stamp, double sweep) const {
+  return wheelsReadyFor(stamp) && imuReadyFor(stamp + std::max(0.0, sweep));
 }
 
-void OdometryPipeline::inputsWaitTimedOut(double stamp) {
+void OdometryPipeline::inputsWaitTimedOut(double stamp, double sweep) {
   if (!wheelsReadyFor(stamp)) odometry_stalled_ = true;
-  if (!imuReadyFor(stamp)) imu_stalled_ = true;
+  if (!imuReadyFor(stamp + std::max(0.0, sweep))) imu_stalled_ = true;
 }
 
 std::string OdometryPipeline::checkGeometry(const RangeScan& ranges) {

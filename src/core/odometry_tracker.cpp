@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -17,6 +18,7 @@ constexpr double kFitnessHalfLife = 50.0;  // matches
 // Variance of the rotation between where two consecutive scans alone put the base (rad^2): two matches
 // against the same map share most of their error; (2 mrad)^2 leaves room for a keyframe change between.
 constexpr double kScanRotationVariance = 0.002 * 0.002;
+constexpr int kDeskewKnots = 16;  // the IMU's turn during a sweep, sampled this often (then linear)
 
 Eigen::Matrix3d symmetricClamped(const Eigen::Matrix3d& covariance) {
   const Eigen::Matrix3d symmetric = 0.5 * (covariance + covariance.transpose());
@@ -462,6 +464,35 @@ bool OdometryTracker::handleTime(double stamp, TrackerUpdate* update) {
   return false;
 }
 
+bool OdometryTracker::deskew(double stamp, const Scan& sensor_scan, Scan* compensated) const {
+  if (!options_.deskew || !initialised_ || !sensor_scan.hasBeamTimes()) return false;
+  const bool velocity_known = extrapolator_.velocityKnown();
+  const Eigen::Vector3d velocity = velocity_known ? extrapolator_.velocity() : Eigen::Vector3d::Zero();
+  // The IMU's turn at kDeskewKnots + 1 times over the sweep, interpolated between for each beam.
+  const double sweep = (sensor_scan.beam_count - 1) * sensor_scan.time_increment;
+  std::array<double, kDeskewKnots + 1> turned{};
+  bool gyro = options_.use_imu && sensor_scan.beam_count > 1;
+  for (int k = 1; gyro && k <= kDeskewKnots; ++k) {
+    const double t = sweep * k / kDeskewKnots;
+    double angle = 0.0;
+    gyro = t >= 0.0 ? extrapolator_.gyroRotation(stamp, stamp + t, &angle)
+                    : extrapolator_.gyroRotation(stamp + t, stamp, &angle);
+    turned[k] = t >= 0.0 ? angle : -angle;
+  }
+  if (!gyro) {
+    if (!velocity_known) return false;
+    *compensated = deskewScan(sensor_scan, laserVelocity(laser_mount_, velocity));
+    return true;
+  }
+  *compensated = deskewScan(sensor_scan, [&](double t) {
+    const double knot = std::clamp(t / sweep * kDeskewKnots, 0.0, static_cast<double>(kDeskewKnots));
+    const int below = std::min(static_cast<int>(knot), kDeskewKnots - 1);
+    const double angle = turned[below] + (knot - below) * (turned[below + 1] - turned[below]);
+    return laser_mount_.inverse() * Pose2D(velocity.x() * t, velocity.y() * t, angle) * laser_mount_;
+  });
+  return true;
+}
+
 void OdometryTracker::initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update) {
   initialised_ = true;
   last_stamp_ = stamp;
@@ -536,11 +567,8 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   // A sweep taken while moving is sheared (the last beam is milliseconds younger than the first), and a
   // match reads the shear as a small turn of one sign per metre: on fr079 it added up to ~25 degrees.
   Scan compensated;
-  const bool deskew =
-      options_.deskew && initialised_ && extrapolator_.velocityKnown() && sensor_scan.hasBeamTimes();
-  if (deskew) compensated = deskewScan(sensor_scan, laserVelocity(laser_mount_, extrapolator_.velocity()));
-  const Scan& scan = deskew ? compensated : sensor_scan;
-  update.deskewed = deskew;
+  update.deskewed = deskew(stamp, sensor_scan, &compensated);
+  const Scan& scan = update.deskewed ? compensated : sensor_scan;
   const bool usable = static_cast<int>(scan.size()) >= options_.min_points;
   if (!initialised_) {
     initialise(stamp, scan, usable, &update);

@@ -36,12 +36,18 @@ MotionPrediction PoseExtrapolator::predict(double from, double to, const MotionN
   return prediction;
 }
 
+bool PoseExtrapolator::gyroRotation(double from, double to, double* angle) const {
+  double raw_angle = 0.0;
+  if (!use_gyro_ || !gyro_.rotation(from, to, &raw_angle)) return false;
+  *angle = raw_angle - gyro_bias_ * (to - from);
+  return true;
+}
+
 void PoseExtrapolator::applyGyro(double from, double to, MotionPrediction* prediction,
                                  std::string* warning) const {
-  double raw_angle = 0.0;
-  if (!gyro_.rotation(from, to, &raw_angle)) return;
+  double angle = 0.0;
+  if (!gyroRotation(from, to, &angle)) return;
   const double dt = to - from;
-  const double angle = raw_angle - gyro_bias_ * dt;
   if (std::abs(angle) > max_turn_rate_ * dt + 0.2) {
     std::ostringstream text;
     text << "IMU rotation of " << angle << " rad in " << dt << " s is faster than odometry/max_turn_rate; "

@@ -53,15 +53,24 @@ Scan scanFromRanges(const RangeScan& input, const ScanConversionOptions& options
     scan.beam_index.push_back(i);
   }
   scan.invalid_count = scan.beam_count - static_cast<int>(scan.points.size());
-  // A sweep longer than a second is no 2D laser's: such a time_increment is a driver's mistake.
-  const double stated_sweep = std::abs(input.time_increment) * (scan.beam_count - 1);
-  if (std::isfinite(input.time_increment) && input.time_increment != 0.0 && stated_sweep <= kMaxSweepTime) {
-    scan.time_increment = input.time_increment;
-  } else if (std::isfinite(options.sweep_time) && options.sweep_time > 0.0 &&
-             options.sweep_time <= kMaxSweepTime && scan.beam_count > 1) {
-    scan.time_increment = options.sweep_time / (scan.beam_count - 1);
+  if (scan.beam_count > 1) {
+    scan.time_increment =
+        scanSweepTime(input.time_increment, scan.beam_count, options) / (scan.beam_count - 1);
   }
   return scan;
+}
+
+double scanSweepTime(double time_increment, std::size_t beam_count, const ScanConversionOptions& options) {
+  if (beam_count < 2) return 0.0;
+  // A sweep longer than a second is no 2D laser's: such a time_increment is a driver's mistake.
+  const double stated_sweep = time_increment * static_cast<double>(beam_count - 1);
+  if (std::isfinite(time_increment) && time_increment != 0.0 && std::abs(stated_sweep) <= kMaxSweepTime) {
+    return stated_sweep;
+  }
+  if (std::isfinite(options.sweep_time) && options.sweep_time > 0.0 && options.sweep_time <= kMaxSweepTime) {
+    return options.sweep_time;
+  }
+  return 0.0;
 }
 
 void ReferencePoints::append(const std::vector<Eigen::Vector2d>& scan_points, const Pose2D& pose) {
@@ -150,13 +159,19 @@ Scan transformScan(const Scan& scan, const Pose2D& pose) {
 }
 
 Scan deskewScan(const Scan& scan, const Eigen::Vector3d& velocity) {
+  if (!velocity.allFinite()) return scan;
+  // Constant velocity, first order: a sweep lasts milliseconds.
+  return deskewScan(scan, [&velocity](double dt) {
+    return Pose2D(velocity.x() * dt, velocity.y() * dt, velocity.z() * dt);
+  });
+}
+
+Scan deskewScan(const Scan& scan, const std::function<Pose2D(double)>& sensor_motion) {
   Scan out = scan;
-  if (!scan.hasBeamTimes() || !velocity.allFinite()) return out;
+  if (!scan.hasBeamTimes()) return out;
   for (std::size_t i = 0; i < out.points.size(); ++i) {
-    // The sensor pose at the beam's time, in the frame of the stamp (constant velocity, first order: a
-    // sweep lasts milliseconds).
-    const double dt = scan.beam_index[i] * scan.time_increment;
-    out.points[i] = Pose2D(velocity.x() * dt, velocity.y() * dt, velocity.z() * dt) * out.points[i];
+    const Pose2D motion = sensor_motion(scan.beam_index[i] * scan.time_increment);
+    if (motion.isFinite()) out.points[i] = motion * out.points[i];
   }
   return out;
 }

@@ -296,7 +296,7 @@ void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
   imu_stale_ = update.imu_stale;
 }
 
-bool LaserOdometry::waitForInputs(double stamp) {
+bool LaserOdometry::waitForInputs(double stamp, double sweep) {
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                              std::chrono::duration<double>(options_.odometry_wait));
@@ -304,11 +304,11 @@ bool LaserOdometry::waitForInputs(double stamp) {
   while (true) {
     takeQueuedInputs();
     if (stop_) return false;
-    if (pipeline_.inputsReadyFor(stamp)) return true;
+    if (pipeline_.inputsReadyFor(stamp, sweep)) return true;
     if (input_cv_.wait_until(lock, deadline) == std::cv_status::timeout) {
       takeQueuedInputs();
       // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
-      pipeline_.inputsWaitTimedOut(stamp);
+      pipeline_.inputsWaitTimedOut(stamp, sweep);
       return !stop_;
     }
   }
@@ -403,7 +403,9 @@ void LaserOdometry::workerLoop() {
       if (stop_) return;
       continue;
     }
-    if (!waitForInputs(msg->header.stamp.toSec())) return;
+    const double sweep =
+        hglasm::scanSweepTime(msg->time_increment, msg->ranges.size(), pipeline_.conversion());
+    if (!waitForInputs(msg->header.stamp.toSec(), sweep)) return;
     processScan(*msg);
   }
 }

@@ -191,6 +191,23 @@ TEST(OdometryPipeline, ImuStalenessChangesAreReportedOnce) {
   EXPECT_EQ(changed, std::vector<bool>({false, false, false, false, true, false, true, false}));
 }
 
+TEST(OdometryPipeline, TheImuIsWaitedForToTheEndOfTheSweep) {
+  // De-skewing takes the IMU's turn during the sweep; the wheels are needed at the stamp only.
+  TrackerOptions options;
+  options.use_imu = true;
+  OdometryPipeline pipeline(options);
+  ASSERT_TRUE(pipeline.addOdometry(1.0, Pose2D()));
+  ASSERT_TRUE(pipeline.addImu(1.05, 0.0));
+  EXPECT_TRUE(pipeline.inputsReadyFor(1.0));
+  EXPECT_FALSE(pipeline.inputsReadyFor(1.0, 0.1));
+  ASSERT_TRUE(pipeline.addImu(1.1, 0.0));
+  EXPECT_TRUE(pipeline.inputsReadyFor(1.0, 0.1));
+  EXPECT_FALSE(pipeline.inputsReadyFor(1.0, 0.2));
+  pipeline.inputsWaitTimedOut(1.0, 0.2);
+  EXPECT_TRUE(pipeline.imuStalled());
+  EXPECT_FALSE(pipeline.odometryStalled());
+}
+
 TEST(OdometryPipeline, AStalledInputIsRevivedOnlyBySamplesAtOrAfterTheLastScan) {
   // An IMU whose samples lag by more than the live wait is not waited for at every scan.
   TrackerOptions options;

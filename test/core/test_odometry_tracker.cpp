@@ -118,7 +118,8 @@ class SimulatedRobot {
         tracker_.addOdometry(odometry_time_, odometry_pose_);
       }
     }
-    while (gyro_ && gyro_time_ + kGyroPeriod <= t + 1e-9) {
+    // As live, the scan is processed once its sweep is over: the IMU's samples of the sweep are there.
+    while (gyro_ && gyro_time_ + kGyroPeriod <= t + sweep_time_ + 1e-9) {
       gyro_time_ += kGyroPeriod;
       // The true rate by a central difference over 1 ms (the paths are piecewise smooth).
       const double rate =
@@ -607,15 +608,18 @@ struct FastTurnRun {
 };
 
 /// Two laps of the square with spins at `turn_rate`, scans at `scan_rate` Hz, wheels that count
-/// `turn_scale` of each turn; with a gyro of `bias` and `noise_density` if `use_imu`, under `gyro`'s model.
+/// `turn_scale` of each turn; with a gyro of `bias` and `noise_density` if `use_imu`, under `gyro`'s model;
+/// each scan's beams measured over `sweep_fraction` of the scan period (0: all at once).
 FastTurnRun runFastTurns(bool use_imu, double turn_rate, double scan_rate, double turn_scale, double bias,
-                         double noise_density, const hglasm::GyroOptions& gyro = {}) {
+                         double noise_density, const hglasm::GyroOptions& gyro = {},
+                         double sweep_fraction = 0.0) {
   TrackerOptions options;
   options.use_imu = use_imu;
   options.imu = gyro;
   const Path path = hglasm_test::squareWithSpins(turn_rate);
   SimulatedRobot robot(options, path);
   robot.enableOdometry(0.0, 0.0, turn_scale);
+  robot.setSweepTime(sweep_fraction / scan_rate);
   if (use_imu) robot.enableGyro(bias, noise_density, 7);
   const double lap = 4.0 * (3.0 + (kPi / 2) / turn_rate);
   FastTurnRun run;
@@ -706,6 +710,26 @@ TEST(OdometryTracker, AGyroSparesTheLeapsThatFastTurnsOtherwiseNeed) {
   EXPECT_EQ(gyro.fallbacks, 0);
   EXPECT_LT(gyro.translation_error, 0.01);
   EXPECT_LT(gyro.worst_rotation_error, hglasm_test::deg(0.5));
+}
+
+TEST(OdometryTracker, WithASweepingLaserTheGyroDeskewsTheSpins) {
+  // A laser whose sweep takes 90 % of its period: at 180 deg/s a 10 Hz sweep is sheared by 16 degrees, and
+  // a spin starts and stops within a sweep, where the velocity of the last poses says nothing. The gyro
+  // gives the turn at every beam.
+  const FastTurnRun wheels = runFastTurns(false, kPi, 10.0, 0.5, 0.0, 0.0, {}, 0.9);
+  const FastTurnRun gyro = runFastTurns(true, kPi, 10.0, 0.5, kGyroBias, kGyroNoiseDensity, {}, 0.9);
+  const FastTurnRun slow = runFastTurns(true, kPi, 5.0, 0.3, kGyroBias, kGyroNoiseDensity, {}, 0.9);
+  printRun("10 Hz sweeping, wheels alone:", wheels);
+  printRun("10 Hz sweeping, gyro:", gyro);
+  printRun("5 Hz sweeping, gyro:", slow);
+  EXPECT_GT(wheels.worst_rotation_error, hglasm_test::deg(10.0)) << "the scenario is not hard for the wheels";
+  EXPECT_EQ(gyro.leaps, 0);
+  EXPECT_LT(gyro.translation_error, 0.02);
+  EXPECT_LT(gyro.worst_rotation_error, hglasm_test::deg(1.0));
+  EXPECT_EQ(slow.leaps, 0);
+  EXPECT_LT(slow.translation_error, 0.05);
+  EXPECT_LT(slow.worst_rotation_error, hglasm_test::deg(3.0));
+  EXPECT_NEAR(gyro.learned_bias, kGyroBias, 0.01);
 }
 
 TEST(OdometryTracker, WhenTheGyroStopsTheWheelsPredictTheRotation) {

@@ -419,3 +419,33 @@ TEST(JoinSurfaces, NeverAcrossScansMissingBeamsOrWithMaxGapZero) {
   off.max_gap = 0.0;
   EXPECT_EQ(hglasm::joinSurfaces(reference, off), std::vector<std::uint8_t>(6, 0));
 }
+
+TEST(ScanSweepTime, OwnTimingFirstThenTheConfiguredSweepElseUnknown) {
+  hglasm::ScanConversionOptions options;
+  EXPECT_DOUBLE_EQ(hglasm::scanSweepTime(1e-4, 1001, options), 0.1);
+  EXPECT_DOUBLE_EQ(hglasm::scanSweepTime(-1e-4, 1001, options), -0.1) << "signed like time_increment";
+  EXPECT_EQ(hglasm::scanSweepTime(0.0, 1001, options), 0.0) << "not known";
+  EXPECT_EQ(hglasm::scanSweepTime(0.01, 1001, options), 0.0) << "10 s: a driver's mistake";
+  options.sweep_time = 0.05;
+  EXPECT_DOUBLE_EQ(hglasm::scanSweepTime(0.0, 1001, options), 0.05);
+  EXPECT_DOUBLE_EQ(hglasm::scanSweepTime(std::nan(""), 1001, options), 0.05);
+  EXPECT_DOUBLE_EQ(hglasm::scanSweepTime(1e-4, 1001, options), 0.1) << "the scan's own timing wins";
+  EXPECT_EQ(hglasm::scanSweepTime(1e-4, 1, options), 0.0) << "one beam has no sweep";
+}
+
+TEST(DeskewScan, APerBeamMotionMovesEachPointByTheSensorPoseAtItsTime) {
+  Scan scan;
+  scan.beam_count = 3;
+  scan.time_increment = 0.1;
+  scan.points = {{1.0, 0.0}, {1.0, 0.0}, {1.0, 0.0}};
+  scan.beam_index = {0, 1, 2};
+  // The sensor turns 1 rad/s for 0.1 s, then stands: beam 2 is seen as beam 1.
+  const Scan out =
+      hglasm::deskewScan(scan, [](double t) { return hglasm::Pose2D(0.0, 0.0, std::min(t, 0.1)); });
+  expectPoint(out.points[0], 1.0, 0.0);
+  expectPoint(out.points[1], std::cos(0.1), std::sin(0.1));
+  expectPoint(out.points[2], std::cos(0.1), std::sin(0.1));
+  scan.time_increment = 0.0;
+  const Scan unchanged = hglasm::deskewScan(scan, [](double) { return hglasm::Pose2D(1.0, 0.0, 0.0); });
+  expectPoint(unchanged.points[2], 1.0, 0.0);  // beam times not known
+}

@@ -73,13 +73,15 @@ class OdometryPipeline {
   /// Stamp of the newest odometry sample added; -infinity before the first.
   double newestOdometryStamp() const { return newest_odometry_stamp_; }
 
-  /// The feeding policy (see the class comment): true once a scan stamped `stamp` may be processed.
-  bool inputsReadyFor(double stamp) const;
+  /// The feeding policy (see the class comment): true once a scan stamped `stamp` may be processed. The
+  /// IMU is waited for to the end of the scan's sweep (`sweep` seconds after the stamp; scanSweepTime):
+  /// de-skewing takes its turn during the sweep.
+  bool inputsReadyFor(double stamp, double sweep = 0.0) const;
 
   /// A live wait for a scan at `stamp` timed out: the wheel odometry, the IMU or both (whichever had no
   /// sample at or after it) count as stalled until a sample of theirs arrives stamped at or after the
   /// newest scan processed: one that lags by more than the wait is not waited for at every scan.
-  void inputsWaitTimedOut(double stamp);
+  void inputsWaitTimedOut(double stamp, double sweep = 0.0);
   bool odometryStalled() const { return odometry_stalled_; }
   bool imuStalled() const { return imu_stalled_; }
 
@@ -131,7 +133,7 @@ class OdometryPipeline {
   double last_scan_stamp_ = -std::numeric_limits<double>::infinity();  // of the last scan processed
   bool imu_stalled_ = false;
   bool wheelsReadyFor(double stamp) const;
-  bool imuReadyFor(double stamp) const;
+  bool imuReadyFor(double stamp) const;  // the stamp the IMU must reach
 
   bool have_geometry_ = false;
   std::size_t beam_count_ = 0;

@@ -193,6 +193,11 @@ class OdometryTracker {
   };
 
   bool handleTime(double stamp, TrackerUpdate* update);
+  /// The scan motion-compensated to its stamp (its beams' times known, scan/deskew): the sensor's turn
+  /// during the sweep from the IMU when it covers the sweep (a turn rate that changes within it, as when
+  /// a spin starts), else from the velocity estimate, which also gives the translation. False: no
+  /// compensation (nothing known about the motion yet).
+  bool deskew(double stamp, const Scan& sensor_scan, Scan* compensated) const;
   Hypotheses hypothesesFor(const MotionPrediction& prediction) const;
   /// log posterior of a match under each hypothesis (up to a common constant).
   void scoreHypotheses(const Scan& scan, const Hypotheses& h, const MatchResult& match, double* holds,

@@ -51,6 +51,9 @@ class PoseExtrapolator {
     gyro_bias_ = bias;
     gyro_bias_variance_ = variance;
   }
+  /// The IMU's rotation of the base from `from` to `to` (bias removed); false without use_gyro or when the
+  /// samples do not cover the interval.
+  bool gyroRotation(double from, double to, double* angle) const;
   /// Drops the IMU samples before `stamp` (GyroBuffer::forgetBefore).
   void forgetGyroBefore(double stamp) { gyro_.forgetBefore(stamp); }
   /// Forgets the wheel odometry and the IMU samples (they belong to another timeline, e.g. time went

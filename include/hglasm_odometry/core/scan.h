@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -118,9 +119,17 @@ Scan selectBeams(const Scan& scan, int parity);
 /// Applies `pose` to every point (beam indices kept).
 Scan transformScan(const Scan& scan, const Pose2D& pose);
 
+/// Seconds from a scan's first beam to its last (signed like time_increment): its own time_increment when
+/// that gives a sweep of at most kMaxSweepTime, else options.sweep_time, else 0 (not known).
+double scanSweepTime(double time_increment, std::size_t beam_count, const ScanConversionOptions& options);
+
 /// Motion compensation: moves every point to where the sensor would have seen it at the scan's stamp,
 /// the sensor moving with `velocity` (vx, vy in m/s, omega in rad/s, in its own frame) during the sweep.
 /// Returns the scan unchanged when its beams' times are not known (time_increment 0).
 Scan deskewScan(const Scan& scan, const Eigen::Vector3d& velocity);
+
+/// The same with the sensor's pose at each beam given: `sensor_motion(t)` is the sensor at t seconds after
+/// the stamp, in its frame at the stamp (a turn rate that changes during the sweep, from a gyro).
+Scan deskewScan(const Scan& scan, const std::function<Pose2D(double)>& sensor_motion);
 
 }  // namespace hglasm

@@ -81,13 +81,13 @@ class LaserOdometry {
   };
 
   void workerLoop();
-  /// Hands the queued odometry and a requested reset or pose to the pipeline. Called by the worker, `lock`
-  /// held.
+  /// Hands the queued odometry, IMU samples and a requested reset or pose to the pipeline. Called by the
+  /// worker, `lock` held.
   void takeQueuedInputs();
   /// Waits (bounded by options_.odometry_wait) until the pipeline's feeding policy lets a scan at `stamp`
-  /// be processed (wheel odometry at or after it has arrived, or none is to be expected). False if the
-  /// worker is to stop.
-  bool waitForInputs(double stamp);
+  /// be processed (wheel odometry at or after it, and IMU samples to the end of its `sweep`, have arrived,
+  /// or none is to be expected). False if the worker is to stop.
+  bool waitForInputs(double stamp, double sweep);
   /// Looks up base -> laser for `laser_frame` (cached); false while tf does not have it yet.
   bool ensureLaserMount(const std::string& laser_frame);
   /// What the pipeline takes from an IMU message: the base's yaw rate (or yaw), rotated into base_frame.
