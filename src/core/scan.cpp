@@ -53,9 +53,11 @@ Scan scanFromRanges(const RangeScan& input, const ScanConversionOptions& options
     scan.beam_index.push_back(i);
   }
   scan.invalid_count = scan.beam_count - static_cast<int>(scan.points.size());
-  if (scan.beam_count > 1) {
-    scan.time_increment =
-        scanSweepTime(input.time_increment, scan.beam_count, options) / (scan.beam_count - 1);
+  const double sweep = scanSweepTime(input.time_increment, scan.beam_count, options);
+  if (sweep != 0.0) {
+    // The scan's own increment exactly when it is the one used; else the configured sweep spread evenly.
+    const bool own = sweep == input.time_increment * static_cast<double>(scan.beam_count - 1);
+    scan.time_increment = own ? input.time_increment : sweep / (scan.beam_count - 1);
   }
   return scan;
 }
