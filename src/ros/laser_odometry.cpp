@@ -43,6 +43,7 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
                              const LaserOdometryOptions& options)
     : options_(options),
       name_(private_nh.getNamespace()),
+      imu_topic_(nh.resolveName("imu")),
       nh_(nh),
       private_nh_(private_nh),
       pipeline_(options.tracker, options.odometry_wait > 0.0),
@@ -87,7 +88,7 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
   ROS_INFO_STREAM("[" << name_ << "] laser odometry on " << scan_sub_.getTopic()
                       << (options_.tracker.use_odometry ? " + " + odom_sub_.getTopic()
                                                         : std::string(" (no wheel odometry)"))
-                      << (options_.tracker.use_imu ? " + " + imu_sub_.getTopic() : std::string()) << ": "
+                      << (options_.tracker.use_imu ? " + " + imu_topic_ : std::string()) << ": "
                       << summarize(options_));
 }
 
@@ -157,7 +158,7 @@ bool LaserOdometry::imuValueInBase(const sensor_msgs::Imu& msg, double* value) {
   if (!imuMount(stripLeadingSlash(msg.header.frame_id), &mount)) return false;
   std::string error;
   if (!imuValueFromMsg(msg, mount, options_.tracker.imu.use_orientation, value, &error)) {
-    warnThrottled("imu_bad", "IMU sample on " + imu_sub_.getTopic() + " ignored: " + error, 10.0);
+    warnThrottled("imu_bad", "IMU sample on " + imu_topic_ + " ignored: " + error, 10.0);
     return false;
   }
   return true;
@@ -174,7 +175,7 @@ bool LaserOdometry::imuMount(const std::string& frame, geometry_msgs::Quaternion
   found.w = 1.0;
   if (frame.empty() && !warned_imu_frame_) {
     warned_imu_frame_ = true;
-    ROS_WARN_STREAM("[" << name_ << "] IMU messages on " << imu_sub_.getTopic()
+    ROS_WARN_STREAM("[" << name_ << "] IMU messages on " << imu_topic_
                         << " carry no frame_id; assuming the IMU is aligned with " << options_.base_frame);
   } else if (!frame.empty() && frame != options_.base_frame) {
     const ros::WallTime now = ros::WallTime::now();
@@ -279,9 +280,9 @@ void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
   if (!update.imu_stale_changed) return;
   if (update.imu_stale) {
     std::ostringstream text;
-    text << "no IMU data on " << imu_sub_.getTopic() << " covers the step to the scan at "
-         << update.tracker.stamp << " s (missing, or a gap longer than imu/max_gap "
-         << options_.tracker.imu.max_gap << " s); the rotation is predicted from "
+    text << "no IMU data on " << imu_topic_ << " covers the step to the scan at " << update.tracker.stamp
+         << " s (missing, or a gap longer than imu/max_gap " << options_.tracker.imu.max_gap
+         << " s); the rotation is predicted from "
          << (update.tracker.prediction == hglasm::PredictionSource::kOdometry ? "the wheel odometry"
              : update.tracker.prediction == hglasm::PredictionSource::kConstantVelocity
                  ? "the recent motion"
@@ -289,8 +290,7 @@ void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
          << " until it returns";
     ROS_WARN_STREAM("[" << name_ << "] " << text.str());
   } else {
-    ROS_INFO_STREAM("[" << name_ << "] IMU data on " << imu_sub_.getTopic()
-                        << " again: the rotation is the IMU's");
+    ROS_INFO_STREAM("[" << name_ << "] IMU data on " << imu_topic_ << " again: the rotation is the IMU's");
   }
   std::lock_guard<std::mutex> lock(stats_mutex_);
   imu_stale_ = update.imu_stale;
@@ -562,7 +562,8 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("dropped scans", dropped_total);
   status.add("queued scans", queued);
   status.add("preset", options_.preset);
-  if (options_.tracker.use_imu) status.add("IMU", imu_stale_ ? "stale: rotation from the wheels" : "in use");
+  if (options_.tracker.use_imu)
+    status.add("IMU", imu_stale_ ? "stale: rotation predicted without it" : "in use");
 
   const bool scans_arriving =
       !last_scan_time_.isZero() && (now - last_scan_time_).toSec() <= options_.diagnostics.window;
@@ -578,7 +579,8 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
     status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%.0f%% of scans failed to match",
                     100.0 * failure_ratio);
   } else if (options_.tracker.use_imu && imu_stale_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "IMU stale or missing: rotation from the wheels");
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "IMU stale or missing: rotation predicted without it");
   } else if (dropped_total > last_reported_drops_) {
     status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
                     "dropping scans: %u dropped so far (processing is slower than the input)", dropped_total);

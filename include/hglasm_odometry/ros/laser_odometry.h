@@ -112,7 +112,8 @@ class LaserOdometry {
   void warnThrottled(const std::string& key, const std::string& text, double period);
 
   const LaserOdometryOptions options_;
-  const std::string name_;  // private namespace, prefixes log lines
+  const std::string name_;       // private namespace, prefixes log lines
+  const std::string imu_topic_;  // resolved `imu` (log lines name it)
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
 
