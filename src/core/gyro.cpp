@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 
 #include "hglasm_odometry/core/pose2d.h"
 
@@ -114,18 +113,16 @@ bool GyroBuffer::rotation(double from, double to, double* angle) const {
        it + 1 != samples_.end() && it->stamp < to; ++it) {
     if ((it + 1)->stamp - it->stamp > options_.max_gap) return false;
   }
-  // The knots of the piecewise-linear signal between the two stamps: the ends and every sample between.
-  std::vector<Sample> knots{{from, valueAt(from)}};
-  for (auto it = after_from; it != samples_.end() && it->stamp < to; ++it) knots.push_back(*it);
-  knots.push_back({to, valueAt(to)});
+  // Along the piecewise-linear signal from knot to knot: `from`, every sample between, `to`.
   double sum = 0.0;
-  for (std::size_t i = 1; i < knots.size(); ++i) {
-    if (options_.use_orientation) {
-      sum += normalizeAngle(knots[i].value - knots[i - 1].value);
-    } else {
-      sum += 0.5 * (knots[i].value + knots[i - 1].value) * (knots[i].stamp - knots[i - 1].stamp);
-    }
-  }
+  Sample previous{from, valueAt(from)};
+  const auto add = [&](const Sample& knot) {
+    sum += options_.use_orientation ? normalizeAngle(knot.value - previous.value)
+                                    : 0.5 * (knot.value + previous.value) * (knot.stamp - previous.stamp);
+    previous = knot;
+  };
+  for (auto it = after_from; it != samples_.end() && it->stamp < to; ++it) add(*it);
+  add(Sample{to, valueAt(to)});
   *angle = sum;
   return true;
 }

@@ -43,28 +43,27 @@ bool OdometryPipeline::addOdometry(double stamp, const Pose2D& pose) {
   // The tracker's buffer rejects the same samples: the newest stamp must only count what it holds.
   if (!std::isfinite(stamp) || !pose.isFinite()) return false;
   tracker_.addOdometry(stamp, pose);
-  if (stamp > newest_odometry_stamp_) newest_odometry_stamp_ = stamp;
-  if (!(stamp < last_scan_stamp_)) odometry_stalled_ = false;
+  wheels_.added(stamp, last_scan_stamp_);
   return true;
 }
 
 bool OdometryPipeline::addImu(double stamp, double value) {
   if (!tracker_.addImu(stamp, value)) return false;
-  if (stamp > newest_imu_stamp_) newest_imu_stamp_ = stamp;
-  if (!(stamp < last_scan_stamp_)) imu_stalled_ = false;
+  imu_.added(stamp, last_scan_stamp_);
   return true;
 }
 
+void OdometryPipeline::InputFeed::added(double stamp, double last_scan) {
+  if (stamp > newest) newest = stamp;
+  if (!(stamp < last_scan)) stalled = false;
+}
+
 bool OdometryPipeline::wheelsReadyFor(double stamp) const {
-  if (!tracker_.options().use_odometry || !wait_for_inputs_) return true;
-  if (!std::isfinite(newest_odometry_stamp_)) return true;  // none yet: nothing to wait for
-  return odometry_stalled_ || newest_odometry_stamp_ >= stamp;
+  return !tracker_.options().use_odometry || !wait_for_inputs_ || wheels_.readyFor(stamp);
 }
 
 bool OdometryPipeline::imuReadyFor(double stamp) const {
-  if (!tracker_.options().use_imu || !wait_for_inputs_) return true;
-  if (!std::isfinite(newest_imu_stamp_)) return true;
-  return imu_stalled_ || newest_imu_stamp_ >= stamp;
+  return !tracker_.options().use_imu || !wait_for_inputs_ || imu_.readyFor(stamp);
 }
 
 bool OdometryPipeline::inputsReadyFor(double stamp, double sweep) const {
@@ -72,8 +71,8 @@ bool OdometryPipeline::inputsReadyFor(double stamp, double sweep) const {
 }
 
 void OdometryPipeline::inputsWaitTimedOut(double stamp, double sweep) {
-  if (!wheelsReadyFor(stamp)) odometry_stalled_ = true;
-  if (!imuReadyFor(stamp + std::max(0.0, sweep))) imu_stalled_ = true;
+  if (!wheelsReadyFor(stamp)) wheels_.stalled = true;
+  if (!imuReadyFor(stamp + std::max(0.0, sweep))) imu_.stalled = true;
 }
 
 std::string OdometryPipeline::checkGeometry(const RangeScan& ranges) {

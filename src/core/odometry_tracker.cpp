@@ -417,14 +417,15 @@ void OdometryTracker::learnNoise(const MotionPrediction& prediction, const Match
   const Pose2D scan_only = fromMap(match.scan_only_pose);
   const bool scan_usable = !match.degenerate && scan_only.isFinite();
   const bool usable = learn_wheels && prediction.source == PredictionSource::kOdometry && scan_usable;
-  if (usable && have_scan_only_pose_) {
-    const Pose2D wheel_error = relativePose(prediction.motion, relativePose(scan_only_pose_, scan_only));
-    noise_.learn(Eigen::Vector3d(wheel_error.x, wheel_error.y, wheel_error.theta), Eigen::Vector3d::Zero(),
-                 prediction.nominal_covariance.diagonal());
-  }
-  if (prediction.gyro && scan_usable && have_scan_rotation_) {
-    const double scan_rotation = normalizeAngle(scan_only.theta - scan_only_pose_.theta);
-    if (gyro_bias_.update(prediction.motion.theta, scan_rotation, kScanRotationVariance, prediction.dt,
+  if (scan_usable && have_scan_rotation_) {
+    const Pose2D scan_motion = relativePose(scan_only_pose_, scan_only);
+    if (usable && have_scan_only_pose_) {
+      const Pose2D wheel_error = relativePose(prediction.motion, scan_motion);
+      noise_.learn(Eigen::Vector3d(wheel_error.x, wheel_error.y, wheel_error.theta), Eigen::Vector3d::Zero(),
+                   prediction.nominal_covariance.diagonal());
+    }
+    if (prediction.gyro &&
+        gyro_bias_.update(prediction.motion.theta, scan_motion.theta, kScanRotationVariance, prediction.dt,
                           last_stamp_ + prediction.dt)) {
       extrapolator_.setGyroBias(gyro_bias_.bias(), gyro_bias_.variance());
     }

@@ -48,7 +48,7 @@ void PoseExtrapolator::applyGyro(double from, double to, MotionPrediction* predi
   double angle = 0.0;
   if (!gyroRotation(from, to, &angle)) return;
   const double dt = to - from;
-  if (std::abs(angle) > max_turn_rate_ * dt + 0.2) {
+  if (!plausibleTurn(angle, dt)) {
     std::ostringstream text;
     text << "IMU rotation of " << angle << " rad in " << dt << " s is faster than odometry/max_turn_rate; "
          << "the rotation is predicted without it";
@@ -85,8 +85,8 @@ MotionPrediction PoseExtrapolator::predictTranslation(double from, double to, co
   if (use_odometry_ && odometry_.poseAt(from, max_odometry_age_, &odom_from) &&
       odometry_.poseAt(to, max_odometry_age_, &odom_to)) {
     const Pose2D motion = relativePose(odom_from, odom_to);
-    const bool plausible = motion.translationNorm() <= max_speed_ * dt + 0.2 &&
-                           std::abs(motion.theta) <= max_turn_rate_ * dt + 0.2;
+    const bool plausible =
+        motion.translationNorm() <= max_speed_ * dt + kJitterMargin && plausibleTurn(motion.theta, dt);
     if (plausible) {
       prediction.source = PredictionSource::kOdometry;
       prediction.motion = motion;

@@ -43,6 +43,11 @@ hglasm::RangeScan rangesAt(const Pose2D& laser_pose, bool upside_down,
   return ranges;
 }
 
+/// The scan of an upright laser mounted at `mount` on a robot on the straight path at time t.
+hglasm::RangeScan straightScan(double t, const Pose2D& mount) {
+  return rangesAt(hglasm_test::composeByHand(straightAt(t), mount), false);
+}
+
 TEST(OdometryPipeline, WaitsForOdometryAtOrAfterTheScan) {
   OdometryPipeline pipeline;
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0)) << "no odometry yet: nothing to wait for";
@@ -279,16 +284,14 @@ TEST(OdometryPipeline, ResetRestartsAtTheOriginAndKeepsTheMount) {
   pipeline.setLaserMount(mount, false);
   for (int i = 0; i <= 5; ++i) {
     const double t = 0.1 * i;
-    pipeline.processScan(t, rangesAt(hglasm_test::composeByHand(straightAt(t), mount), false));
+    pipeline.processScan(t, straightScan(t, mount));
   }
   EXPECT_GT(pipeline.pose().x, 0.2);
   pipeline.reset();
-  const PipelineUpdate first =
-      pipeline.processScan(0.6, rangesAt(hglasm_test::composeByHand(straightAt(0.6), mount), false));
+  const PipelineUpdate first = pipeline.processScan(0.6, straightScan(0.6, mount));
   EXPECT_TRUE(first.tracker.reset);
   EXPECT_EQ(first.tracker.pose.x, 0.0);
-  const PipelineUpdate second =
-      pipeline.processScan(0.7, rangesAt(hglasm_test::composeByHand(straightAt(0.7), mount), false));
+  const PipelineUpdate second = pipeline.processScan(0.7, straightScan(0.7, mount));
   ASSERT_TRUE(second.laser_guess.has_value());
   // From the new keyframe (the origin): 5 cm ahead, seen from the mounted laser.
   hglasm_test::expectPoseNear(second.tracker.pose, Pose2D(0.05, 0.0, 0.0), 0.01, 0.005, "after reset");
@@ -304,20 +307,18 @@ TEST(OdometryPipeline, SetPoseRestartsFromThePoseAndKeepsTheMount) {
   pipeline.setLaserMount(mount, false);
   for (int i = 0; i <= 5; ++i) {
     const double t = 0.1 * i;
-    pipeline.processScan(t, rangesAt(hglasm_test::composeByHand(straightAt(t), mount), false));
+    pipeline.processScan(t, straightScan(t, mount));
   }
   const Pose2D set(5.0, -2.0, 1.0);
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity() * 0.01;
   EXPECT_FALSE(pipeline.setPose(0.6, set, -covariance));
   ASSERT_TRUE(pipeline.setPose(0.6, set, covariance));
   hglasm_test::expectPoseNear(pipeline.pose(), set, 1e-12, 1e-12, "pipeline.pose()");
-  const PipelineUpdate first =
-      pipeline.processScan(0.6, rangesAt(hglasm_test::composeByHand(straightAt(0.6), mount), false));
+  const PipelineUpdate first = pipeline.processScan(0.6, straightScan(0.6, mount));
   EXPECT_TRUE(first.tracker.reset);
   hglasm_test::expectPoseNear(first.tracker.pose, set, 1e-12, 1e-12, "first.tracker.pose");
   EXPECT_TRUE(first.tracker.pose_covariance.isApprox(covariance, 1e-12));
-  const PipelineUpdate second =
-      pipeline.processScan(0.7, rangesAt(hglasm_test::composeByHand(straightAt(0.7), mount), false));
+  const PipelineUpdate second = pipeline.processScan(0.7, straightScan(0.7, mount));
   ASSERT_TRUE(second.laser_guess.has_value());
   hglasm_test::expectPoseNear(second.tracker.pose, set * Pose2D(0.05, 0.0, 0.0), 0.01, 0.005, "after set");
   // The guess is relative to the new keyframe at the set pose: the identity (no motion known yet).
@@ -340,8 +341,7 @@ TEST(OdometryPipeline, ExposesTheLocalMapInTheOdometryFrameAndItsRevisionPerKeyf
   int keyframes = 0;
   for (int i = 0; i <= 20; ++i) {
     const double t = 0.1 * i;
-    const PipelineUpdate update =
-        pipeline.processScan(t, rangesAt(hglasm_test::composeByHand(straightAt(t), mount), false));
+    const PipelineUpdate update = pipeline.processScan(t, straightScan(t, mount));
     ASSERT_TRUE(update.tracker.published);
     const bool changed = pipeline.localMap().revision() != revision;
     revision = pipeline.localMap().revision();
@@ -371,7 +371,7 @@ TEST(OdometryPipeline, ExposesTheLocalMapInTheOdometryFrameAndItsRevisionPerKeyf
   }
   EXPECT_GT(near, 0.8 * map.reference().size());
   pipeline.reset();
-  pipeline.processScan(2.1, rangesAt(hglasm_test::composeByHand(straightAt(2.1), mount), false));
+  pipeline.processScan(2.1, straightScan(2.1, mount));
   EXPECT_NE(pipeline.localMap().revision(), revision) << "a reset rebuilds the map";
 }
 

@@ -121,11 +121,8 @@ class SimulatedRobot {
     // As live, the scan is processed once its sweep is over: the IMU's samples of the sweep are there.
     while (gyro_ && gyro_time_ + kGyroPeriod <= t + sweep_time_ + 1e-9) {
       gyro_time_ += kGyroPeriod;
-      // The true rate by a central difference over 1 ms (the paths are piecewise smooth).
-      const double rate =
-          hglasm_test::angleDiff(path_(gyro_time_ + 5e-4).theta, path_(gyro_time_ - 5e-4).theta) / 1e-3;
       std::normal_distribution<double> noise(0.0, gyro_sigma_);
-      tracker_.addImu(gyro_time_, rate + gyro_bias_ + noise(gyro_random_));
+      tracker_.addImu(gyro_time_, hglasm_test::yawRate(path_, gyro_time_) + gyro_bias_ + noise(gyro_random_));
     }
     return scan ? tracker_.processScan(t, *scan) : tracker_.processScan(t, scanAt(t));
   }

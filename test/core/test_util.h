@@ -153,6 +153,11 @@ inline std::function<hglasm::Pose2D(double)> squareWithSpins(double turn_rate) {
   };
 }
 
+/// The yaw rate (rad/s) of `path` at t: a central difference over 1 ms (the paths are piecewise smooth).
+inline double yawRate(const std::function<hglasm::Pose2D(double)>& path, double t) {
+  return angleDiff(path(t + 5e-4).theta, path(t - 5e-4).theta) / 1e-3;
+}
+
 // ------------------------------------------------------------------ the simulated laser
 
 struct LaserSpec {

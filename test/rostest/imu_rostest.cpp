@@ -62,8 +62,7 @@ class SimulatedImu {
     std::normal_distribution<double> noise(0.0, kImuNoiseDensity / std::sqrt(kImuPeriod));
     for (; t_ + kImuPeriod <= t + 1e-9;) {
       t_ += kImuPeriod;
-      const double yaw_rate =
-          hglasm_test::angleDiff(path_(t_ + 5e-4).theta, path_(t_ - 5e-4).theta) / 1e-3 + kImuBias;
+      const double yaw_rate = hglasm_test::yawRate(path_, t_) + kImuBias;
       const double sample_noise = noise(random_);
       if (silent) continue;
       const Eigen::Quaterniond base(Eigen::AngleAxisd(path_(t_).theta, Eigen::Vector3d::UnitZ()));

@@ -71,7 +71,7 @@ class OdometryPipeline {
   bool addImu(double stamp, double value);
 
   /// Stamp of the newest odometry sample added; -infinity before the first.
-  double newestOdometryStamp() const { return newest_odometry_stamp_; }
+  double newestOdometryStamp() const { return wheels_.newest; }
 
   /// The feeding policy (see the class comment): true once a scan stamped `stamp` may be processed. The
   /// IMU is waited for to the end of the scan's sweep (`sweep` seconds after the stamp; scanSweepTime):
@@ -82,8 +82,8 @@ class OdometryPipeline {
   /// sample at or after it) count as stalled until a sample of theirs arrives stamped at or after the
   /// newest scan processed: one that lags by more than the wait is not waited for at every scan.
   void inputsWaitTimedOut(double stamp, double sweep = 0.0);
-  bool odometryStalled() const { return odometry_stalled_; }
-  bool imuStalled() const { return imu_stalled_; }
+  bool odometryStalled() const { return wheels_.stalled; }
+  bool imuStalled() const { return imu_.stalled; }
 
   /// Offline replay of recorded odometry, under the feeding policy: adds the samples [next, end) (sorted
   /// by stamp; each with .stamp and .pose) that a live node holds when it processes a scan at `stamp`:
@@ -127,11 +127,19 @@ class OdometryPipeline {
   bool wait_for_inputs_;
   ScanConversionOptions conversion_;
   Pose2D base_to_laser_;
-  double newest_odometry_stamp_ = -std::numeric_limits<double>::infinity();
-  bool odometry_stalled_ = false;
-  double newest_imu_stamp_ = -std::numeric_limits<double>::infinity();
+  /// One input the scans wait for (wheel odometry, the IMU) under the feeding policy.
+  struct InputFeed {
+    double newest = -std::numeric_limits<double>::infinity();  ///< stamp of the newest sample added
+    bool stalled = false;
+    /// A sample stamped `stamp` was added; only one at or after the last scan processed revives a stalled
+    /// input (one that lags by more than the wait is not waited for at every scan).
+    void added(double stamp, double last_scan);
+    /// A scan needing samples up to `stamp` may go on: one has come, or none ever did (nothing to wait
+    /// for), or the input stalled.
+    bool readyFor(double stamp) const { return !std::isfinite(newest) || stalled || newest >= stamp; }
+  };
+  InputFeed wheels_, imu_;
   double last_scan_stamp_ = -std::numeric_limits<double>::infinity();  // of the last scan processed
-  bool imu_stalled_ = false;
   bool wheelsReadyFor(double stamp) const;
   bool imuReadyFor(double stamp) const;  // the stamp the IMU must reach
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <deque>
 #include <string>
 
@@ -85,6 +86,11 @@ class PoseExtrapolator {
   static constexpr double kMaxVelocityAge = 2.0;    // seconds: older motion says nothing about the speed now
 
  private:
+  /// A turn of `angle` in `dt` seconds within max_turn_rate (plus kJitterMargin), whoever measured it.
+  bool plausibleTurn(double angle, double dt) const {
+    return std::abs(angle) <= max_turn_rate_ * dt + kJitterMargin;
+  }
+  static constexpr double kJitterMargin = 0.2;  // m or rad a plausible motion may exceed its rate bound by
   /// The wheels' or the velocity's prediction.
   MotionPrediction predictTranslation(double from, double to, const MotionNoiseModel& noise,
                                       std::string* warning) const;
