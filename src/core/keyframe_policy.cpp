@@ -10,14 +10,8 @@ KeyframePolicy::KeyframePolicy(double distance, double angle, double min_fitness
 bool KeyframePolicy::wantsKeyframe(const Pose2D& pose, bool matched, bool match_failed,
                                    double fitness_ratio) const {
   const Pose2D since_keyframe = relativePose(pose_, pose);
-  return requested_ || match_failed || since_keyframe.translationNorm() > distance_ ||
+  return match_failed || since_keyframe.translationNorm() > distance_ ||
          std::abs(since_keyframe.theta) > angle_ || (matched && fitness_ratio < min_fitness_);
-}
-
-void KeyframePolicy::keyframeAdded(const Pose2D& pose, int beam_count) {
-  requested_ = false;
-  pose_ = pose;
-  beam_count_ = beam_count;
 }
 
 }  // namespace hglasm

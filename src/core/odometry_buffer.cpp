@@ -10,9 +10,49 @@ bool OdometryBuffer::add(double stamp, const Pose2D& pose) {
   const auto later = std::upper_bound(samples_.begin(), samples_.end(), stamp,
                                       [](double t, const Sample& sample) { return t < sample.stamp; });
   samples_.insert(later, Sample{stamp, pose});
-  const double oldest_kept = samples_.back().stamp - max_age_;
-  while (samples_.size() > 2 && samples_.front().stamp < oldest_kept) samples_.pop_front();
+  prune();
   return true;
+}
+
+void OdometryBuffer::keepAround(double stamp, double margin) {
+  if (!std::isfinite(stamp)) return;
+  keep_from_ = stamp - std::abs(margin);
+  keep_to_ = stamp + std::abs(margin);
+}
+
+void OdometryBuffer::prune() {
+  if (samples_.size() <= 2) return;
+  const auto first_at_or_after = [this](double t) {
+    return std::lower_bound(samples_.begin(), samples_.end(), t,
+                            [](const Sample& sample, double value) { return sample.stamp < value; });
+  };
+  // The recent span (at least the two newest samples), and the one kept around keep_from_..keep_to_ with
+  // the samples that bracket it; everything else older than max_age goes.
+  auto recent = std::min(first_at_or_after(samples_.back().stamp - max_age_), samples_.end() - 2);
+  if (!std::isfinite(keep_to_)) {
+    samples_.erase(samples_.begin(), recent);
+    return;
+  }
+  auto kept_end = first_at_or_after(keep_to_);
+  if (kept_end != samples_.end()) ++kept_end;
+  if (kept_end < recent) recent = samples_.erase(kept_end, recent);
+  auto kept_begin = first_at_or_after(keep_from_);
+  if (kept_begin != samples_.begin()) --kept_begin;
+  samples_.erase(samples_.begin(), std::min(kept_begin, recent));
+}
+
+double OdometryBuffer::largestGap(double from, double to) const {
+  if (samples_.empty() || !(samples_.front().stamp <= from) || !(samples_.back().stamp >= to)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  auto it = std::upper_bound(samples_.begin(), samples_.end(), from,
+                             [](double t, const Sample& sample) { return t < sample.stamp; });
+  if (it != samples_.begin()) --it;  // the last sample at or before `from`
+  double largest = 0.0;
+  for (auto next = it + 1; next != samples_.end() && it->stamp < to; ++it, ++next) {
+    largest = std::max(largest, next->stamp - it->stamp);
+  }
+  return largest;
 }
 
 double OdometryBuffer::newestStamp() const { return samples_.empty() ? 0.0 : samples_.back().stamp; }

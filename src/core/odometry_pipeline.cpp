@@ -28,8 +28,27 @@ ScanConversionOptions conversionForMount(ScanConversionOptions conversion, bool 
   return conversion;
 }
 
+const char* toString(SampleVerdict verdict) {
+  switch (verdict) {
+    case SampleVerdict::kTaken:
+      return "taken";
+    case SampleVerdict::kInvalid:
+      return "invalid";
+    case SampleVerdict::kStale:
+      return "stale";
+    case SampleVerdict::kNewTimeline:
+      return "new_timeline";
+  }
+  return "unknown";
+}
+
 OdometryPipeline::OdometryPipeline(const TrackerOptions& options, bool wait_for_odometry)
-    : tracker_(options), wait_for_inputs_(wait_for_odometry), conversion_(options.conversion) {}
+    : tracker_(options),
+      wait_for_inputs_(wait_for_odometry),
+      conversion_(options.conversion),
+      wheels_(options.reset_on_jump_back),
+      imu_(options.reset_on_jump_back),
+      scan_order_(options.reset_on_jump_back) {}
 
 bool OdometryPipeline::setLaserMount(const Pose2D& base_to_laser, bool upside_down) {
   if (!base_to_laser.isFinite()) return false;
@@ -39,27 +58,45 @@ bool OdometryPipeline::setLaserMount(const Pose2D& base_to_laser, bool upside_do
   return true;
 }
 
-bool OdometryPipeline::addOdometry(double stamp, const Pose2D& pose) {
-  // The tracker's buffer rejects the same samples: the newest stamp must only count what it holds.
-  if (!std::isfinite(stamp) || !pose.isFinite()) return false;
+SampleVerdict OdometryPipeline::addOdometry(double stamp, const Pose2D& pose) {
+  if (!std::isfinite(stamp) || !pose.isFinite()) return SampleVerdict::kInvalid;
+  const StampOrder::Verdict verdict = wheels_.take(stamp, scan_order_.newest() + odometryTimeOffset());
+  if (verdict == StampOrder::Verdict::kStale) return SampleVerdict::kStale;
+  if (verdict == StampOrder::Verdict::kJumpedBack) tracker_.clearOdometry();
   tracker_.addOdometry(stamp, pose);
-  wheels_.added(stamp, last_scan_stamp_);
-  return true;
+  return verdict == StampOrder::Verdict::kJumpedBack ? SampleVerdict::kNewTimeline : SampleVerdict::kTaken;
 }
 
-bool OdometryPipeline::addImu(double stamp, double value) {
-  if (!tracker_.addImu(stamp, value)) return false;
-  imu_.added(stamp, last_scan_stamp_);
-  return true;
+SampleVerdict OdometryPipeline::addImu(double stamp, double value) {
+  if (!tracker_.options().use_imu || !std::isfinite(stamp) || !std::isfinite(value)) {
+    return SampleVerdict::kInvalid;
+  }
+  const StampOrder::Verdict verdict = imu_.take(stamp, scan_order_.newest());
+  if (verdict == StampOrder::Verdict::kStale) return SampleVerdict::kStale;
+  if (verdict == StampOrder::Verdict::kJumpedBack) tracker_.clearImu();
+  tracker_.addImu(stamp, value);
+  return verdict == StampOrder::Verdict::kJumpedBack ? SampleVerdict::kNewTimeline : SampleVerdict::kTaken;
 }
 
-void OdometryPipeline::InputFeed::added(double stamp, double last_scan) {
-  if (stamp > newest) newest = stamp;
-  if (!(stamp < last_scan)) stalled = false;
+InputCounts OdometryPipeline::inputCounts() const {
+  InputCounts counts;
+  counts.stale_scans = scan_order_.staleCount();
+  counts.stale_odometry = wheels_.order.staleCount();
+  counts.stale_imu = imu_.order.staleCount();
+  counts.jumps_back = scan_order_.jumpsBack();
+  return counts;
+}
+
+StampOrder::Verdict OdometryPipeline::InputFeed::take(double stamp, double needed_by_last_scan) {
+  const StampOrder::Verdict verdict = order.take(stamp);
+  const bool caught_up = verdict == StampOrder::Verdict::kInOrder && !(stamp < needed_by_last_scan);
+  if (verdict == StampOrder::Verdict::kJumpedBack || caught_up) stalled = false;
+  return verdict;
 }
 
 bool OdometryPipeline::wheelsReadyFor(double stamp) const {
-  return !tracker_.options().use_odometry || !wait_for_inputs_ || wheels_.readyFor(stamp);
+  return !tracker_.options().use_odometry || !wait_for_inputs_ ||
+         wheels_.readyFor(stamp + tracker_.odometryTimeOffset());
 }
 
 bool OdometryPipeline::imuReadyFor(double stamp) const {
@@ -67,7 +104,8 @@ bool OdometryPipeline::imuReadyFor(double stamp) const {
 }
 
 bool OdometryPipeline::inputsReadyFor(double stamp, double sweep) const {
-  return wheelsReadyFor(stamp) && imuReadyFor(stamp + std::max(0.0, sweep));
+  const bool dropped = stamp < scan_order_.newest() && !scan_order_.behind(stamp);
+  return dropped || (wheelsReadyFor(stamp) && imuReadyFor(stamp + std::max(0.0, sweep)));
 }
 
 void OdometryPipeline::inputsWaitTimedOut(double stamp, double sweep) {
@@ -75,41 +113,63 @@ void OdometryPipeline::inputsWaitTimedOut(double stamp, double sweep) {
   if (!imuReadyFor(stamp + std::max(0.0, sweep))) imu_.stalled = true;
 }
 
-std::string OdometryPipeline::checkGeometry(const RangeScan& ranges) {
-  // The tracker compares beam counts only: a changed angular geometry with the same beam count would be
-  // matched against a reference of other geometry. Make such a scan a keyframe.
-  std::string warning;
-  const bool increment_changed =
-      have_geometry_ && ranges.ranges.size() == beam_count_ &&
-      std::abs(ranges.angle_increment - angle_increment_) > 1e-6 * std::abs(angle_increment_) + 1e-9;
-  if (increment_changed) {
-    std::ostringstream text;
-    text << "scan angle_increment changed from " << angle_increment_ << " to " << ranges.angle_increment
-         << "; new keyframe";
-    warning = text.str();
-    tracker_.requestKeyframe();
+PipelineUpdate OdometryPipeline::staleScan(double stamp, double newest) const {
+  PipelineUpdate update;
+  update.tracker.stamp = stamp;
+  update.tracker.stale = true;
+  update.tracker.pose = tracker_.pose();
+  std::ostringstream text;
+  text << "scan stamped " << (newest - stamp) << " s before the last one processed: dropped";
+  update.tracker.warning = text.str();
+  update.imu_stale = imu_stale_;
+  return update;
+}
+
+std::string OdometryPipeline::restartTimeline(double stamp, double newest) {
+  std::ostringstream text;
+  text << "scan time went back by " << (newest - stamp)
+       << " s (more than time/reset_on_jump_back: a looped bag or a restarted clock)";
+  // Inputs whose newest sample is still on the old timeline hold samples of other instants at the new
+  // stamps: mixed with the new ones they would turn every prediction into a jump.
+  if (wheels_.order.behind(stamp)) {
+    tracker_.clearOdometry();
+    wheels_.order.restart();
+    wheels_.stalled = false;
   }
-  have_geometry_ = true;
-  beam_count_ = ranges.ranges.size();
-  angle_increment_ = ranges.angle_increment;
-  return warning;
+  if (imu_.order.behind(stamp)) {
+    tracker_.clearImu();
+    imu_.order.restart();
+    imu_.stalled = false;
+  }
+  reset();
+  text << "; odometry reset to the origin";
+  return text.str();
 }
 
 PipelineUpdate OdometryPipeline::processScan(double stamp, const RangeScan& ranges,
                                              std::vector<Pose2D>* population) {
   PipelineUpdate update;
-  if (std::isfinite(stamp)) last_scan_stamp_ = stamp;
+  std::string timeline_warning;
+  if (std::isfinite(stamp)) {
+    const double newest = scan_order_.newest();
+    const StampOrder::Verdict verdict = scan_order_.take(stamp);
+    if (verdict == StampOrder::Verdict::kStale) return staleScan(stamp, newest);
+    update.jumped_back = verdict == StampOrder::Verdict::kJumpedBack;
+    if (update.jumped_back) timeline_warning = restartTimeline(stamp, newest);
+  }
   const double cpu_start = threadCpuMs();
   update.scan = scanFromRanges(ranges, conversion_, &update.scan_error);
   update.conversion_cpu_ms = threadCpuMs() - cpu_start;
   update.scan_error_changed = update.scan_error != scan_error_;
   scan_error_ = update.scan_error;
-  // A broken scan says nothing reliable about the scanner's geometry.
-  if (update.scan_error == ScanError::kNone) update.geometry_warning = checkGeometry(ranges);
 
   // The keyframe before this scan: the one the guess is relative to.
   const Pose2D keyframe_before = keyframe_pose_;
   update.tracker = tracker_.processScan(stamp, update.scan, population);
+  if (!timeline_warning.empty()) {
+    update.tracker.warning =
+        timeline_warning + (update.tracker.warning.empty() ? "" : "; " + update.tracker.warning);
+  }
   const TrackerUpdate& result = update.tracker;
   if (result.matched) {
     // The tracker's own conjugation of the predicted base motion by the mount.

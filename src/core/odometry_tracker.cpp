@@ -121,7 +121,9 @@ OdometryTracker::OdometryTracker(const TrackerOptions& options)
       keyframes_(options.keyframe_distance, options.keyframe_angle, options.keyframe_min_fitness),
       noise_(options.motion),
       gyro_bias_(options.imu),
+      time_offset_(options.odometry_time_offset),
       local_map_(options.local_map) {
+  extrapolator_.setOdometryTimeOffset(time_offset_.offset());
   if (!matcherHasGradedTable(options_.matcher.algorithm)) {
     LookupTableOptions graded = options_.matcher.table;
     graded.kind = TableKind::kGraded;
@@ -140,7 +142,6 @@ void OdometryTracker::addOdometry(double stamp, const Pose2D& odom_pose) {
 void OdometryTracker::reset() {
   initialised_ = false;
   local_map_.clear();
-  keyframes_.cancelRequest();
   pose_ = Pose2D();
   pose_covariance_.setZero();
   map_covariance_.setZero();
@@ -450,19 +451,25 @@ OdometryTracker::Estimate OdometryTracker::integratePrediction(const MotionPredi
   return estimate;
 }
 
-bool OdometryTracker::handleTime(double stamp, TrackerUpdate* update) {
-  if (!initialised_) return true;
-  const double dt = stamp - last_stamp_;
-  if (dt >= 0.0 && dt <= options_.max_time_jump) return true;
+bool OdometryTracker::refuseStale(double stamp, TrackerUpdate* update) const {
+  if (!initialised_ || !(stamp < last_stamp_)) return false;
   std::ostringstream text;
-  text << "scan time " << (dt < 0.0 ? "went back" : "jumped forward") << " by " << std::abs(dt)
-       << " s; odometry reset to the origin";
+  text << "scan stamped " << last_stamp_ - stamp << " s before the last one processed; dropped";
   update->warning = text.str();
-  reset();
-  // Back in time, the odometry history is of another timeline (a looped bag, a clock reset): mixed with
-  // the new samples at the same stamps it would turn every prediction into a jump.
-  if (dt < 0.0) extrapolator_.clearSensorHistory();
-  return false;
+  update->stale = true;
+  update->pose = pose_;
+  update->pose_covariance = pose_covariance_;
+  return true;
+}
+
+void OdometryTracker::learnTimeOffset(double stamp) {
+  if (!options_.use_odometry) return;
+  time_offset_.addScanPose(stamp, scan_only_pose_);
+  const double before = time_offset_.offset();
+  if (!time_offset_.update(extrapolator_.odometry())) return;
+  extrapolator_.setOdometryTimeOffset(time_offset_.offset());
+  // The wheels' noise was learned from predictions read at the wrong time: it was mostly the offset's.
+  if (std::abs(time_offset_.offset() - before) >= TimeOffsetEstimator::kMinOffset) noise_.resetLearning();
 }
 
 bool OdometryTracker::deskew(double stamp, const Scan& sensor_scan, Scan* compensated) const {
@@ -498,6 +505,7 @@ void OdometryTracker::initialise(double stamp, const Scan& scan, bool usable, Tr
   initialised_ = true;
   last_stamp_ = stamp;
   if (set_pose_stamp_) advanceSetPose(stamp, update);
+  extrapolator_.startNextPredictionAt(stamp, options_.odometry_time_offset.max_offset);
   extrapolator_.addPose(stamp, pose_);
   update->reset = true;
   update->published = true;
@@ -533,18 +541,19 @@ void OdometryTracker::addKeyframe(const Scan& scan) {
   // The pose's uncertainty relative to the map stays; only the frame it is expressed in turns.
   map_covariance_ = had_map ? rotateCovariance(relativePose(local_map_.frame(), old_frame), map_covariance_)
                             : Eigen::Matrix3d::Zero();
-  keyframes_.keyframeAdded(pose_, scan.beam_count);
+  keyframes_.keyframeAdded(pose_);
   ++keyframe_id_;
 }
 
 void OdometryTracker::updateKeyframe(const Scan& scan, bool usable, TrackerUpdate* update) {
   if (!usable) return;  // a scan without geometry cannot become a keyframe
-  const bool scanner_changed = !local_map_.empty() && keyframes_.scannerChanged(scan.beam_count);
-  if (scanner_changed && update->warning.empty()) {
-    update->warning = "scan beam count changed from " + std::to_string(keyframes_.keyframeBeamCount()) +
-                      " to " + std::to_string(scan.beam_count) + "; new keyframe";
+  // A usable scan the map could not explain (the robot moved during a pause, the surroundings changed):
+  // the map no longer describes where the robot is, so it restarts from this scan, at the pose predicted.
+  if (update->fallback && !local_map_.empty()) {
+    local_map_.clear();
+    update->reanchored = true;
   }
-  if (local_map_.empty() || scanner_changed ||
+  if (local_map_.empty() ||
       keyframes_.wantsKeyframe(pose_, update->matched, update->fallback, update->fitness_ratio)) {
     addKeyframe(scan);
     update->new_keyframe = true;
@@ -563,7 +572,9 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
     update.pose_covariance = pose_covariance_;
     return update;
   }
-  handleTime(stamp, &update);
+  if (refuseStale(stamp, &update)) return update;
+  update.odometry_time_offset = time_offset_.offset();  // the one this scan's prediction reads with
+  update.odometry_time_offset_estimate = time_offset_.estimate();
 
   // A sweep taken while moving is sheared (the last beam is milliseconds younger than the first), and a
   // match reads the shear as a small turn of one sign per metre: on fr079 it added up to ~25 degrees.
@@ -590,6 +601,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
     update.matched = true;
     update.map_keyframes = static_cast<int>(local_map_.keyframeCount());
     matched = matchScan(scan, prediction, population_out, &update, &estimate);
+    if (matched && have_scan_rotation_ && !update.leap) learnTimeOffset(stamp);
   } else {
     update.match.status = local_map_.empty() ? MatchStatus::kNoReference : MatchStatus::kTooFewPoints;
   }
@@ -614,7 +626,7 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   updateVelocity(stamp, new_pose, &update);
   pose_ = new_pose;
   last_stamp_ = stamp;
-  extrapolator_.forgetGyroBefore(stamp);  // the next step starts here
+  extrapolator_.startNextPredictionAt(stamp, options_.odometry_time_offset.max_offset);
   updateKeyframe(scan, usable, &update);
 
   update.published = true;

@@ -82,8 +82,9 @@ MotionPrediction PoseExtrapolator::predictTranslation(double from, double to, co
   MotionPrediction prediction;
   const double dt = to - from;
   Pose2D odom_from, odom_to;
-  if (use_odometry_ && odometry_.poseAt(from, max_odometry_age_, &odom_from) &&
-      odometry_.poseAt(to, max_odometry_age_, &odom_to)) {
+  const double shift = odometry_time_offset_;
+  if (use_odometry_ && odometry_.poseAt(from + shift, max_odometry_age_, &odom_from) &&
+      odometry_.poseAt(to + shift, max_odometry_age_, &odom_to)) {
     const Pose2D motion = relativePose(odom_from, odom_to);
     const bool plausible =
         motion.translationNorm() <= max_speed_ * dt + kJitterMargin && plausibleTurn(motion.theta, dt);
@@ -99,8 +100,10 @@ MotionPrediction PoseExtrapolator::predictTranslation(double from, double to, co
          << dt << " s; using the constant-velocity prediction";
     *warning = text.str();
   }
-  prediction.covariance = noise.constantVelocityCovariance(dt);
-  if (velocity_known_) {
+  // After a pause longer than the velocity's memory the robot may have stopped or turned: the pose is
+  // kept, as uncertain as the velocity's memory allows (the search is the preset's box).
+  prediction.covariance = noise.constantVelocityCovariance(std::min(dt, kMaxVelocityAge));
+  if (velocity_known_ && dt <= kMaxVelocityAge) {
     prediction.source = PredictionSource::kConstantVelocity;
     prediction.motion = Pose2D(velocity_.x() * dt, velocity_.y() * dt, velocity_.z() * dt);
   }

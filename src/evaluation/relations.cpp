@@ -68,6 +68,14 @@ bool readRelations(const std::string& path, std::vector<Relation>* relations, st
   return true;
 }
 
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const std::size_t half = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + half, values.end());
+  if (values.size() % 2) return values[half];
+  return 0.5 * (values[half] + *std::max_element(values.begin(), values.begin() + half));
+}
+
 RelationStats evaluateRelations(const std::vector<Relation>& relations,
                                 const std::vector<StampedPose>& trajectory, double max_span,
                                 double stamp_tolerance) {
@@ -118,6 +126,8 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
   };
   moments(trans_errors, &stats.trans_mean, &stats.trans_std, &stats.trans_sq_mean);
   moments(rot_errors_deg, &stats.rot_mean_deg, &stats.rot_std_deg, &stats.rot_sq_mean_deg);
+  stats.trans_median = median(trans_errors);
+  stats.rot_median_deg = median(rot_errors_deg);
   return stats;
 }
 

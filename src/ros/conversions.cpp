@@ -40,8 +40,8 @@ void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
   match->prediction_source = toMsg(update.prediction);
   match->rotation_from_imu = update.rotation_from_imu;
   match->imu_bias = finiteFloat(update.imu_bias);
-  match->status = toMsg(update.match.status);
-  match->status_text = hglasm::toString(update.match.status);
+  match->status = update.stale ? static_cast<uint8_t>(Match::STATUS_STALE) : toMsg(update.match.status);
+  match->status_text = update.stale ? "stale" : hglasm::toString(update.match.status);
   match->jump_rejected = update.jump_rejected;
   match->prediction_doubted = update.prediction_doubted;
   match->leap = update.leap;
@@ -60,6 +60,9 @@ void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
   match->fallback = update.fallback;
   match->new_keyframe = update.new_keyframe;
   match->reset = update.reset;
+  match->reanchored = update.reanchored;
+  match->odometry_time_offset = finiteFloat(update.odometry_time_offset);
+  match->odometry_time_offset_estimate = finiteFloat(update.odometry_time_offset_estimate);
   match->keyframe_id = nonNegative(update.keyframe_id);
 }
 

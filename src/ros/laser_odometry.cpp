@@ -36,6 +36,7 @@ constexpr double kTfRetrySeconds = 0.05;  // wall time between tf lookups while 
 constexpr std::size_t kMaxQueuedOdometry = 10000;  // samples kept while the worker waits (100 s at 100 Hz)
 constexpr int kImuSubscriberQueue = 1000;
 constexpr std::size_t kMaxQueuedImu = 20000;  // 20 s at 1 kHz
+constexpr double kStaleWarnPeriod = 10.0;     // seconds between warnings about inputs stamped out of order
 
 }  // namespace
 
@@ -44,6 +45,7 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
     : options_(options),
       name_(private_nh.getNamespace()),
       imu_topic_(nh.resolveName("imu")),
+      odom_topic_(nh.resolveName("odom")),
       nh_(nh),
       private_nh_(private_nh),
       pipeline_(options.tracker, options.odometry_wait > 0.0),
@@ -265,15 +267,30 @@ void LaserOdometry::takeQueuedInputs() {
     if (!sample.child_frame.empty() && sample.child_frame != options_.base_frame &&
         !warned_odom_child_frame_) {
       warned_odom_child_frame_ = true;  // once: the configuration will not change by itself
-      ROS_WARN_STREAM("[" << name_ << "] wheel odometry on " << odom_sub_.getTopic() << " is of frame \""
+      ROS_WARN_STREAM("[" << name_ << "] wheel odometry on " << odom_topic_ << " is of frame \""
                           << sample.child_frame << "\", not of base_frame \"" << options_.base_frame
                           << "\"; it is used as the motion of base_frame anyway");
     }
-    pipeline_.addOdometry(sample.stamp, sample.pose);
+    reportSample(false, pipeline_.addOdometry(sample.stamp, sample.pose));
   }
   odometry_.clear();
-  for (const ImuSample& sample : imu_) pipeline_.addImu(sample.stamp, sample.value);
+  for (const ImuSample& sample : imu_) reportSample(true, pipeline_.addImu(sample.stamp, sample.value));
   imu_.clear();
+}
+
+void LaserOdometry::reportSample(bool imu, hglasm::SampleVerdict verdict) {
+  if (verdict == hglasm::SampleVerdict::kTaken || verdict == hglasm::SampleVerdict::kInvalid) return;
+  const std::string input = imu ? "IMU data on " + imu_topic_ : "wheel odometry on " + odom_topic_;
+  if (verdict == hglasm::SampleVerdict::kStale) {
+    warnThrottled(
+        "stale " + input,
+        input + " stamped before its newest sample: dropped (the time policy; counted in diagnostics)",
+        kStaleWarnPeriod);
+  } else if (verdict == hglasm::SampleVerdict::kNewTimeline) {
+    ROS_WARN_STREAM("[" << name_ << "] " << input
+                        << " went back in time by more than time/reset_on_jump_back "
+                        << options_.tracker.reset_on_jump_back << " s: its earlier samples are forgotten");
+  }
 }
 
 void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
@@ -297,9 +314,12 @@ void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
 }
 
 bool LaserOdometry::waitForInputs(double stamp, double sweep) {
+  // Wheels whose stamps run late are waited for that much longer: their pose of the scan's instant comes
+  // with a later message.
+  const double wait = options_.odometry_wait + std::max(0.0, pipeline_.odometryTimeOffset());
   const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                             std::chrono::duration<double>(options_.odometry_wait));
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wait));
   std::unique_lock<std::mutex> lock(input_mutex_);
   while (true) {
     takeQueuedInputs();
@@ -430,8 +450,11 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
       ROS_INFO_STREAM("[" << name_ << "] scans are valid again");
     }
   }
-  if (!result.geometry_warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << result.geometry_warning);
-  if (!update.warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << update.warning);
+  if (update.stale) {
+    warnThrottled("stale scan", update.warning + " (counted in diagnostics)", kStaleWarnPeriod);
+  } else if (!update.warning.empty()) {
+    ROS_WARN_STREAM("[" << name_ << "] " << update.warning);
+  }
   reportImuState(result);
   if (update.reset) path_.clear();
 
@@ -445,6 +468,10 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
   record.matched = update.matched;
   record.fallback = update.fallback;
   std::lock_guard<std::mutex> lock(stats_mutex_);
+  input_counts_ = pipeline_.inputCounts();
+  time_offset_ = update.odometry_time_offset;
+  time_offset_estimate_ = update.odometry_time_offset_estimate;
+  if (update.stale) return;  // not processed: not a scan of the rate or failure statistics
   ++scans_processed_;
   if (update.fallback) ++fallbacks_;
   if (update.reset) ++resets_;
@@ -559,7 +586,16 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("scans processed", scans_processed_);
   status.add("fallbacks", fallbacks_);
   status.add("resets", resets_);
+  status.add("clock jumps back (resets)", input_counts_.jumps_back);
   status.add("dropped scans", dropped_total);
+  status.add("stale scans dropped", input_counts_.stale_scans);
+  status.add("stale odometry samples dropped", input_counts_.stale_odometry);
+  if (options_.tracker.use_imu) status.add("stale IMU samples dropped", input_counts_.stale_imu);
+  if (options_.tracker.use_odometry) {
+    status.add("odometry time offset (s)", time_offset_);
+    status.add("odometry time offset, estimate (s)", time_offset_estimate_);
+    status.add("odometry time offset", options_.tracker.odometry_time_offset.estimate ? "learned" : "fixed");
+  }
   status.add("queued scans", queued);
   status.add("preset", options_.preset);
   if (options_.tracker.use_imu)

@@ -16,6 +16,7 @@ namespace {
 using XmlRpc::XmlRpcValue;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kMaxFixedTimeOffset = 10.0;  // seconds: odometry/time_offset set by hand
 
 /// "5", "-0.3", "string \"abc\"", "a list": how a value appears in an error message.
 std::string describe(const XmlRpcValue& value) {
@@ -208,6 +209,34 @@ class ParamTree : public OptionVisitor<ParamTree> {
     }
   }
 
+  /// "auto" (learned from the matches) or a fixed number of seconds within +-kMaxFixedTimeOffset.
+  void timeOffset(const std::string& path, hglasm::TimeOffsetOptions* out) {
+    XmlRpcValue value;
+    if (!find(path, &value)) return;
+    const std::string requirement = "auto or a number of seconds in [-" + formatNumber(kMaxFixedTimeOffset) +
+                                    ", " + formatNumber(kMaxFixedTimeOffset) + "]";
+    if (value.getType() == XmlRpcValue::TypeString && static_cast<std::string>(value) == "auto") {
+      out->estimate = true;
+      out->offset = 0.0;
+      return;
+    }
+    double seconds = 0.0;
+    if (value.getType() == XmlRpcValue::TypeInt) {
+      seconds = static_cast<int>(value);
+    } else if (value.getType() == XmlRpcValue::TypeDouble) {
+      seconds = static_cast<double>(value);
+    } else {
+      fail(path, requirement, describe(value));
+      return;
+    }
+    if (!(std::abs(seconds) <= kMaxFixedTimeOffset)) {
+      fail(path, requirement, describe(value));
+      return;
+    }
+    out->estimate = false;
+    out->offset = seconds;
+  }
+
   /// Leaf paths present in the tree but never read (typos), skipping the given top-level keys.
   std::vector<std::string> unknownPaths(const std::set<std::string>& skipped_top_level) const {
     std::vector<std::string> unknown;
@@ -250,6 +279,9 @@ class ParamWriter : public OptionVisitor<ParamWriter> {
   void topic(const std::string& path, std::string* value) { set(path, XmlRpcValue(*value)); }
   void algorithm(const std::string& path, hglasm::Algorithm* value) {
     set(path, XmlRpcValue(std::string(hglasm::toString(*value))));
+  }
+  void timeOffset(const std::string& path, hglasm::TimeOffsetOptions* value) {
+    set(path, value->estimate ? XmlRpcValue(std::string("auto")) : XmlRpcValue(value->offset));
   }
 
  private:
@@ -294,7 +326,7 @@ void visitTrackerOptions(Params& tree, hglasm::TrackerOptions* options) {
   tree.fraction("min_fitness", &tracker.min_fitness);
   tree.positiveInteger("min_points", &tracker.min_points);
   tree.number("fallback_covariance_scale", &tracker.fallback_covariance_scale, 1.0, 1e12);
-  tree.positiveNumber("max_time_jump", &tracker.max_time_jump);
+  tree.positiveNumber("time/reset_on_jump_back", &tracker.reset_on_jump_back);
 
   // The search around the prediction, and leaps away from it.
   tree.boolean("fusion", &tracker.fusion);
@@ -319,6 +351,8 @@ template <typename Params>
 void visitPredictionOptions(Params& tree, LaserOdometryOptions* options) {
   hglasm::TrackerOptions& tracker = options->tracker;
   tree.nonNegativeNumber("odometry/max_extrapolation", &tracker.odometry_max_extrapolation);
+  tree.timeOffset("odometry/time_offset", &tracker.odometry_time_offset);
+  tree.number("odometry/max_time_offset", &tracker.odometry_time_offset.max_offset, 0.0, kMaxFixedTimeOffset);
   hglasm::MotionNoiseOptions& motion = tracker.motion;
   tree.nonNegativeNumber("odometry/noise/xy_per_metre", &motion.xy_per_metre);
   tree.nonNegativeNumber("odometry/noise/xy_per_radian", &motion.xy_per_radian);
@@ -480,6 +514,16 @@ bool checkConsistency(const LaserOdometryOptions& options, std::string* error) {
   return true;
 }
 
+/// What a user is told of a parameter nobody reads: a retired one says what replaced it.
+std::string unknownParameterWarning(const std::string& path) {
+  if (path == "~max_time_jump") {
+    return "parameter ~max_time_jump is no longer used (ignored): a forward gap in the scans' stamps of any "
+           "length continues from the current pose; only a clock that jumps back by more than "
+           "~time/reset_on_jump_back resets";
+  }
+  return "unknown parameter " + path + " (ignored)";
+}
+
 /// Layer 1: the built-in values of the preset ~preset names. *in_yaml: ~presets/<name> exists (layer 2),
 /// then copied into *preset_tree.
 bool startFromPreset(ParamTree& top, LaserOdometryOptions* options, bool* in_yaml, XmlRpcValue* preset_tree,
@@ -564,7 +608,7 @@ bool loadOptions(const XmlRpcValue& private_params, LaserOdometryOptions* option
   if (warnings) {
     // diagnostic_period belongs to diagnostic_updater, which reads it from the same namespace.
     for (const std::string& path : top.unknownPaths({"presets", "diagnostic_period"})) {
-      warnings->push_back("unknown parameter " + path + " (ignored)");
+      warnings->push_back(unknownParameterWarning(path));
     }
   }
   return true;

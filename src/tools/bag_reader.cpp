@@ -119,6 +119,8 @@ void readMessages(rosbag::Bag* bag, const BagReadOptions& options, BagData* data
       if (!scan) continue;
       BagScan bag_scan;
       bag_scan.stamp = scan->header.stamp.toSec();
+      bag_scan.receive_time = message.getTime().toSec();
+      bag_scan.sequence = data->scans.size() + data->odometry.size();
       bag_scan.frame_id = stripLeadingSlash(scan->header.frame_id);
       bag_scan.ranges = rangeScanFromMsg(*scan);
       if (contents->laser_frame.empty()) contents->laser_frame = bag_scan.frame_id;
@@ -132,6 +134,8 @@ void readMessages(rosbag::Bag* bag, const BagReadOptions& options, BagData* data
       BagOdometry sample;
       if (!odom || !pose2DFromOdometryMsg(*odom, &sample.pose)) continue;
       sample.stamp = odom->header.stamp.toSec();
+      sample.receive_time = message.getTime().toSec();
+      sample.sequence = data->scans.size() + data->odometry.size();
       if (contents->odom_child_frame.empty())
         contents->odom_child_frame = stripLeadingSlash(odom->child_frame_id);
       data->odometry.push_back(sample);
@@ -163,7 +167,30 @@ void resolveMount(const BagContents& contents, BagData* data) {
   data->laser_upside_down = mount.upside_down;
 }
 
+/// data->arrivals: every message by receive time; at one receive time, in the order read.
+void orderArrivals(BagData* data) {
+  data->arrivals.clear();
+  for (std::size_t i = 0; i < data->scans.size(); ++i) data->arrivals.push_back(BagArrival{true, i});
+  for (std::size_t i = 0; i < data->odometry.size(); ++i) data->arrivals.push_back(BagArrival{false, i});
+  const auto key = [data](const BagArrival& arrival) {
+    return arrival.scan
+               ? std::make_pair(data->scans[arrival.index].receive_time, data->scans[arrival.index].sequence)
+               : std::make_pair(data->odometry[arrival.index].receive_time,
+                                data->odometry[arrival.index].sequence);
+  };
+  std::sort(data->arrivals.begin(), data->arrivals.end(),
+            [&](const BagArrival& a, const BagArrival& b) { return key(a) < key(b); });
+}
+
 }  // namespace
+
+void shiftOdometry(double seconds, BagData* data) {
+  for (BagOdometry& sample : data->odometry) {
+    sample.stamp += seconds;
+    sample.receive_time += seconds;
+  }
+  orderArrivals(data);
+}
 
 bool readBag(const std::string& path, const BagReadOptions& options, BagData* data, std::string* error) {
   *data = BagData();
@@ -193,6 +220,7 @@ bool readBag(const std::string& path, const BagReadOptions& options, BagData* da
   const auto by_stamp = [](const auto& a, const auto& b) { return a.stamp < b.stamp; };
   std::stable_sort(data->scans.begin(), data->scans.end(), by_stamp);
   std::stable_sort(data->odometry.begin(), data->odometry.end(), by_stamp);
+  orderArrivals(data);
 
   data->base_frame = stripLeadingSlash(options.base_frame);
   if (data->base_frame.empty()) data->base_frame = contents.odom_child_frame;

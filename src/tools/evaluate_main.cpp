@@ -22,6 +22,7 @@
 #include "hglasm_odometry/ros/parameters.h"
 #include "hglasm_odometry/tools/argument_parser.h"
 #include "hglasm_odometry/tools/bag_reader.h"
+#include "hglasm_odometry/tools/bag_replay.h"
 #include "hglasm_odometry/tools/yaml_parameters.h"
 
 #include <ros/package.h>
@@ -48,6 +49,9 @@ const char kUsage[] =
     "  --min-scan-interval S   skip scans stamped less than S s after the last processed one\n"
     "  --laser-mount X,Y,YAW   base -> laser (m, m, rad) instead of the bag's tf\n"
     "  --max-scans N           process only the first N scans\n"
+    "  --odom-stamp-shift S    move every wheel-odometry message S s later (stamp and arrival): wheels that\n"
+    "                          lag the scans by S s, for the time-offset estimation (the wheel baseline\n"
+    "                          is read S s later too, so it stays the bag's)\n"
     "  --angle-increment A     override the scans' angle increment (radians)\n"
     "  --angle-min A           override the scans' first beam angle (radians)\n"
     "  --max-span S            short-relation span for the second metric row (default 10 s)\n"
@@ -75,6 +79,7 @@ struct Arguments {
   bool override_mount = false;
   hglasm::Pose2D laser_mount;
   std::size_t max_scans = 0;
+  double odom_stamp_shift = 0.0;
   bool override_increment = false;
   double angle_increment = 0.0;
   bool override_angle_min = false;
@@ -116,6 +121,7 @@ hglasm_odometry::ArgumentParser::Result parseArguments(int argc, char** argv, Ar
   parser.addFlag("--quiet", &args->quiet);
   parser.addFlag("--direct-pairs", &args->direct_pairs);
   parser.addOption("--max-scans", &args->max_scans);
+  parser.addOption("--odom-stamp-shift", &args->odom_stamp_shift);
   parser.addOption("--angle-increment", &args->angle_increment, &args->override_increment);
   parser.addOption("--angle-min", &args->angle_min, &args->override_angle_min);
   parser.addOption("--laser-mount", [args](const std::string& text, std::string* error) {
@@ -254,17 +260,17 @@ bool writeTrace(const std::string& path, const std::vector<hglasm::TrackerUpdate
   std::fprintf(file,
                "# stamp x y theta prediction matched fallback doubted leap rejected keyframe map_keyframes "
                "box_x box_y box_theta population mahalanobis fitness status mbicp_iterations noise_xy "
-               "noise_theta guess_x guess_y guess_theta leap_probability vx vy wz\n");
+               "noise_theta guess_x guess_y guess_theta leap_probability vx vy wz time_offset\n");
   for (const auto& u : updates) {
     std::fprintf(file,
                  "%.6f %.4f %.4f %.5f %s %d %d %d %d %d %d %d %.3f %.3f %.3f %d %.2f %.3f %s %d %.3g %.3g "
-                 "%.4f %.4f %.5f %.3g %.4f %.4f %.4f\n",
+                 "%.4f %.4f %.5f %.3g %.4f %.4f %.4f %.3f\n",
                  u.stamp, u.pose.x, u.pose.y, u.pose.theta, hglasm::toString(u.prediction), u.matched,
                  u.fallback, u.prediction_doubted, u.leap, u.jump_rejected, u.new_keyframe, u.map_keyframes,
                  u.search.box.half_x, u.search.box.half_y, u.search.box.half_theta, u.search.population,
                  u.prior_mahalanobis, u.fitness_ratio, hglasm::toString(u.match.status), u.match.iterations,
                  u.noise_scale.xy, u.noise_scale.theta, u.guess.x, u.guess.y, u.guess.theta,
-                 u.leap_probability, u.velocity.x(), u.velocity.y(), u.velocity.z());
+                 u.leap_probability, u.velocity.x(), u.velocity.y(), u.velocity.z(), u.odometry_time_offset);
   }
   return std::fclose(file) == 0;
 }
@@ -319,6 +325,9 @@ void printStatsRows(const char* label, const hglasm::RelationStats& laser, const
     std::printf(" | %.4f +- %.4f  %6.3f +- %6.3f", wheel.trans_mean, wheel.trans_std, wheel.rot_mean_deg,
                 wheel.rot_std_deg);
   }
+  std::printf("\n  %-9s %13s | median %.4f m  %6.3f deg    ", "", "", laser.trans_median,
+              laser.rot_median_deg);
+  if (has_wheel) std::printf(" | median %.4f m  %6.3f deg", wheel.trans_median, wheel.rot_median_deg);
   std::printf("\n  %-9s %13s | sq %.6f m2  %9.4f deg2", "", "", laser.trans_sq_mean, laser.rot_sq_mean_deg);
   if (has_wheel) std::printf(" | sq %.6f m2  %9.4f deg2", wheel.trans_sq_mean, wheel.rot_sq_mean_deg);
   std::printf("\n");
@@ -326,11 +335,14 @@ void printStatsRows(const char* label, const hglasm::RelationStats& laser, const
 
 /// What one pass of the tracker over the bag produced.
 struct Run {
-  std::vector<hglasm::StampedPose> trajectory;  ///< published base poses
-  std::size_t processed = 0, skipped = 0;
+  std::vector<hglasm::StampedPose> trajectory;  ///< published base poses, by stamp
+  std::size_t processed = 0, skipped = 0, stale = 0;
   int matched = 0, fallbacks = 0, keyframes = 0, resets = 0, conversion_errors = 0, warnings = 0;
-  int deskewed = 0;
-  std::string beam_times;  ///< where the first scan's beam times came from
+  int deskewed = 0, reanchored = 0;
+  hglasm_odometry::ReplayCounts replay;
+  hglasm::InputCounts inputs;
+  double time_offset = 0.0;  ///< the wheels' time offset in use at the end
+  std::string beam_times;    ///< where the first scan's beam times came from
   std::map<std::string, int> statuses, predictions;
   std::vector<double> total_ms, convert_ms, prealign_ms, refine_ms, table_ms;
   std::vector<hglasm::TrackerUpdate> updates;  ///< every published scan's update, in order
@@ -353,32 +365,27 @@ hglasm::RangeScan rangesOf(const Arguments& args, const hglasm_odometry::BagScan
   return ranges;
 }
 
-/// Runs the nodelet's pipeline over the bag: the bag's laser mount, wheel odometry fed under the
-/// pipeline's policy (what the live node holds after its wait for odometry), the scans in stamp order.
+/// Runs the nodelet's pipeline over the bag as the nodelet receives it (hglasm_odometry::replayBag): the
+/// bag's laser mount, scans and wheel odometry in the bag's order, each scan waiting for its inputs as the
+/// nodelet's worker does at a 1x playback.
 Run runTracker(const Arguments& args, const hglasm_odometry::LaserOdometryOptions& nodelet_options,
                const hglasm::TrackerOptions& options, const hglasm_odometry::BagData& data) {
   Run run;
   hglasm::OdometryPipeline pipeline(options, nodelet_options.odometry_wait > 0.0);
   hglasm_odometry::setLaserMount(data, &pipeline);
-
-  auto next_odometry = data.odometry.begin();
+  hglasm_odometry::BagData bag = data;
+  for (auto& bag_scan : bag.scans) bag_scan.ranges = rangesOf(args, bag_scan);
+  hglasm_odometry::ReplayOptions replay;
+  replay.odometry_wait = nodelet_options.odometry_wait;
+  replay.queue_size = static_cast<std::size_t>(nodelet_options.queue_size);
   double last_processed_stamp = -std::numeric_limits<double>::infinity();
-  for (const auto& bag_scan : data.scans) {
-    if (bag_scan.stamp - last_processed_stamp < args.min_scan_interval) {
-      ++run.skipped;
-      continue;
-    }
-    last_processed_stamp = bag_scan.stamp;
-    next_odometry = pipeline.addRecordedOdometry(next_odometry, data.odometry.end(), bag_scan.stamp);
-    const hglasm::RangeScan ranges = rangesOf(args, bag_scan);
-
-    const double start = cpuMs();
-    const hglasm::PipelineUpdate result = pipeline.processScan(bag_scan.stamp, ranges);
-    const double end = cpuMs();
+  const auto record = [&](const hglasm_odometry::ReplayedScan& replayed) {
+    const hglasm::PipelineUpdate& result = replayed.update;
     const hglasm::TrackerUpdate& update = result.tracker;
-
+    const double stamp = replayed.scan->stamp;
     ++run.processed;
-    run.total_ms.push_back(end - start);
+    run.stale += update.stale;
+    run.total_ms.push_back(replayed.cpu_ms);
     run.convert_ms.push_back(result.conversion_cpu_ms);
     if (result.scan_error != hglasm::ScanError::kNone) ++run.conversion_errors;
     if (update.matched) {
@@ -388,22 +395,42 @@ Run runTracker(const Arguments& args, const hglasm_odometry::LaserOdometryOption
       ++run.statuses[hglasm::toString(update.match.status)];
     }
     if (update.new_keyframe) run.table_ms.push_back(update.table_build_ms);
-    ++run.predictions[hglasm::toString(update.prediction)];
+    if (!update.stale) ++run.predictions[hglasm::toString(update.prediction)];
     run.fallbacks += update.fallback;
     run.deskewed += update.deskewed;
-    if (run.beam_times.empty()) run.beam_times = beamTimesOf(ranges, result.scan);
+    run.reanchored += update.reanchored;
+    if (run.beam_times.empty()) run.beam_times = beamTimesOf(replayed.scan->ranges, result.scan);
     run.keyframes += update.new_keyframe;
     run.resets += update.reset;
-    for (const std::string* warning : {&result.geometry_warning, &update.warning}) {
-      if (!warning->empty() && ++run.warnings <= 20 && !args.quiet) {
-        std::printf("  warning at %.6f: %s\n", bag_scan.stamp, warning->c_str());
-      }
+    if (!update.warning.empty() && ++run.warnings <= 20 && !args.quiet) {
+      std::printf("  warning at %.6f: %s\n", stamp, update.warning.c_str());
     }
     if (update.published) {
-      run.trajectory.push_back({bag_scan.stamp, update.pose});
+      run.trajectory.push_back({stamp, update.pose});
       run.updates.push_back(update);
     }
+    last_processed_stamp = stamp;
+  };
+  // --min-scan-interval thins the scans before they reach the nodelet (as a throttled topic would).
+  if (args.min_scan_interval > 0.0) {
+    std::vector<hglasm_odometry::BagArrival> kept;
+    double last_kept = -std::numeric_limits<double>::infinity();
+    for (const auto& arrival : bag.arrivals) {
+      if (arrival.scan) {
+        const double stamp = bag.scans[arrival.index].stamp;
+        if (stamp - last_kept < args.min_scan_interval) {
+          ++run.skipped;
+          continue;
+        }
+        last_kept = stamp;
+      }
+      kept.push_back(arrival);
+    }
+    bag.arrivals = kept;
   }
+  run.replay = hglasm_odometry::replayBag(bag, &pipeline, replay, record);
+  run.inputs = pipeline.inputCounts();
+  run.time_offset = pipeline.odometryTimeOffset();
   return run;
 }
 
@@ -412,6 +439,14 @@ void printRun(const Run& run, double data_seconds) {
   if (run.skipped) std::printf("\nskipped       %zu scans (--min-scan-interval)", run.skipped);
   std::printf("\nscans         %zu processed, %d matched, %d keyframes, %d resets, %zu published\n", scans,
               run.matched, run.keyframes, run.resets, run.trajectory.size());
+  std::printf(
+      "time policy   %zu stale scans and %llu stale odometry samples dropped, %llu clock jumps back; "
+      "%zu scans dropped by the queue, %zu waits for inputs timed out (bag order, 1x playback)\n",
+      run.stale, static_cast<unsigned long long>(run.inputs.stale_odometry),
+      static_cast<unsigned long long>(run.inputs.jumps_back), run.replay.queue_drops,
+      run.replay.wait_timeouts);
+  std::printf("local map     re-anchored %d times (a scan that did not fit it)\n", run.reanchored);
+  std::printf("odometry lag  time offset %.3f s in use at the end (odometry/time_offset)\n", run.time_offset);
   std::printf("fallbacks     %d (%.2f %% of scans), conversion errors %d, warnings %d\n", run.fallbacks,
               scans ? 100.0 * run.fallbacks / scans : 0.0, run.conversion_errors, run.warnings);
   std::printf("de-skewed     %d scans; beam times %s\n", run.deskewed, run.beam_times.c_str());
@@ -600,12 +635,15 @@ void printRelations(const Arguments& args, const std::string& preset_name, const
       "SUMMARY preset=%s scans=%zu fallbacks=%d fallback_pct=%.3f cpu_median_ms=%.3f cpu_p99_ms=%.3f "
       "cpu_max_ms=%.3f all_t=%.4f all_r=%.3f short_t=%.4f short_r=%.3f wheel_all_t=%.4f "
       "wheel_all_r=%.3f wheel_short_t=%.4f wheel_short_r=%.3f laser_frame_short_t=%.4f "
-      "laser_frame_short_r=%.3f calibration=%.3f worst_leap=%.3f\n",
+      "laser_frame_short_r=%.3f calibration=%.3f worst_leap=%.3f time_offset=%.3f resets=%d keyframes=%d "
+      "short_t_median=%.4f short_r_median=%.3f wheel_short_t_median=%.4f wheel_short_r_median=%.3f\n",
       preset_name.c_str(), scans, run.fallbacks, scans ? 100.0 * run.fallbacks / scans : 0.0, total.median,
       total.p99, total.max, laser_all.trans_mean, laser_all.rot_mean_deg, laser_short.trans_mean,
       laser_short.rot_mean_deg, wheel_all.trans_mean, wheel_all.rot_mean_deg, wheel_short.trans_mean,
       wheel_short.rot_mean_deg, laser_frame_short.trans_mean, laser_frame_short.rot_mean_deg,
-      calibration.mean_sq_mahalanobis, worst_leap);
+      calibration.mean_sq_mahalanobis, worst_leap, run.time_offset, run.resets, run.keyframes,
+      laser_short.trans_median, laser_short.rot_median_deg, wheel_short.trans_median,
+      wheel_short.rot_median_deg);
 }
 
 /// The bag (its laser mount replaced by --laser-mount if given) and the relations, with a line on each.
@@ -724,6 +762,11 @@ int main(int argc, char** argv) {
   hglasm_odometry::BagData data;
   std::vector<hglasm::Relation> relations;
   if (!readInputs(args, nodelet_options.base_frame, &data, &relations)) return 1;
+  if (args.odom_stamp_shift != 0.0) {
+    hglasm_odometry::shiftOdometry(args.odom_stamp_shift, &data);
+    std::printf("odometry      every message moved %.3f s later (--odom-stamp-shift)\n",
+                args.odom_stamp_shift);
+  }
   std::printf("options       %s, preset %s, wheel odometry %s\n", args.config.c_str(),
               nodelet_options.preset.c_str(),
               !options.use_odometry   ? "off"
@@ -737,7 +780,9 @@ int main(int argc, char** argv) {
   std::vector<hglasm::StampedPose> wheel_trajectory;
   for (const auto& bag_scan : data.scans) {
     hglasm::Pose2D pose;
-    if (wheelPoseAt(data.odometry, bag_scan.stamp, &pose)) wheel_trajectory.push_back({bag_scan.stamp, pose});
+    if (wheelPoseAt(data.odometry, bag_scan.stamp + args.odom_stamp_shift, &pose)) {
+      wheel_trajectory.push_back({bag_scan.stamp, pose});
+    }
   }
   if (!relations.empty())
     printRelations(args, nodelet_options.preset, run, relations, wheel_trajectory, options, data);

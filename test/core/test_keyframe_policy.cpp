@@ -1,5 +1,6 @@
 // Which scans become keyframes: moved or turned past the thresholds since the newest keyframe (measured
-// between the two base poses, angles wrapped), a failed or poor match, a request, another beam count.
+// between the two base poses, angles wrapped), a failed or poor match (another scanner geometry is no
+// reason).
 #include "hglasm_odometry/core/keyframe_policy.h"
 
 #include <gtest/gtest.h>
@@ -19,7 +20,7 @@ constexpr double kMinFitness = 0.6;  // fitness ratio
 /// A policy whose newest keyframe was taken with the base at `keyframe` by a 360-beam scanner.
 KeyframePolicy policyAt(const Pose2D& keyframe) {
   KeyframePolicy policy(kDistance, kAngle, kMinFitness);
-  policy.keyframeAdded(keyframe, 360);
+  policy.keyframeAdded(keyframe);
   return policy;
 }
 
@@ -60,37 +61,13 @@ TEST(KeyframePolicy, FailedOrPoorMatch) {
   EXPECT_FALSE(policy.wantsKeyframe(here, false, false, 0.0));
 }
 
-TEST(KeyframePolicy, RequestHoldsUntilAKeyframeIsAddedOrItIsCancelled) {
-  const Pose2D here(1.0, 1.0, 0.5);
-  KeyframePolicy policy = policyAt(here);
-  policy.request();
-  EXPECT_TRUE(movedEnough(policy, here));
-  EXPECT_TRUE(movedEnough(policy, here));  // asking does not consume the request
-  policy.keyframeAdded(here, 360);
-  EXPECT_FALSE(movedEnough(policy, here));
-  policy.request();
-  policy.cancelRequest();
-  EXPECT_FALSE(movedEnough(policy, here));
-}
-
 TEST(KeyframePolicy, KeyframeAddedMovesTheReference) {
   KeyframePolicy policy = policyAt(Pose2D(0.0, 0.0, 0.0));
   const Pose2D far(3.0, 0.0, 1.0);
   EXPECT_TRUE(movedEnough(policy, far));
-  policy.keyframeAdded(far, 360);
+  policy.keyframeAdded(far);
   EXPECT_FALSE(movedEnough(policy, far));
   EXPECT_TRUE(movedEnough(policy, Pose2D(0.0, 0.0, 0.0)));
-}
-
-TEST(KeyframePolicy, BeamCountOfTheNewestKeyframe) {
-  KeyframePolicy policy = policyAt(Pose2D());
-  EXPECT_EQ(policy.keyframeBeamCount(), 360);
-  EXPECT_FALSE(policy.scannerChanged(360));
-  EXPECT_TRUE(policy.scannerChanged(361));
-  policy.keyframeAdded(Pose2D(), 181);
-  EXPECT_EQ(policy.keyframeBeamCount(), 181);
-  EXPECT_TRUE(policy.scannerChanged(360));
-  EXPECT_FALSE(policy.scannerChanged(181));
 }
 
 }  // namespace

@@ -18,6 +18,7 @@ namespace {
 using hglasm::OdometryPipeline;
 using hglasm::PipelineUpdate;
 using hglasm::Pose2D;
+using hglasm::SampleVerdict;
 using hglasm::TrackerOptions;
 
 struct Sample {
@@ -52,24 +53,24 @@ TEST(OdometryPipeline, WaitsForOdometryAtOrAfterTheScan) {
   OdometryPipeline pipeline;
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0)) << "no odometry yet: nothing to wait for";
   EXPECT_EQ(pipeline.newestOdometryStamp(), -std::numeric_limits<double>::infinity());
-  ASSERT_TRUE(pipeline.addOdometry(0.9, Pose2D()));
+  ASSERT_EQ(pipeline.addOdometry(0.9, Pose2D()), SampleVerdict::kTaken);
   EXPECT_FALSE(pipeline.inputsReadyFor(1.0)) << "the sample after the scan is still to come";
-  ASSERT_TRUE(pipeline.addOdometry(1.0, Pose2D()));
+  ASSERT_EQ(pipeline.addOdometry(1.0, Pose2D()), SampleVerdict::kTaken);
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0)) << "a sample at the scan's stamp";
   EXPECT_FALSE(pipeline.inputsReadyFor(1.05));
   EXPECT_FALSE(pipeline.inputsReadyFor(5.0)) << "old odometry is waited for: a gap in the data, not a stop";
   pipeline.inputsWaitTimedOut(5.0);
   EXPECT_TRUE(pipeline.odometryStalled());
   EXPECT_TRUE(pipeline.inputsReadyFor(5.0)) << "after a wait timed out, odometry counts as stalled";
-  EXPECT_FALSE(pipeline.addOdometry(std::nan(""), Pose2D()));
-  EXPECT_FALSE(pipeline.addOdometry(2.0, Pose2D(std::nan(""), 0.0, 0.0)));
+  EXPECT_EQ(pipeline.addOdometry(std::nan(""), Pose2D()), SampleVerdict::kInvalid);
+  EXPECT_EQ(pipeline.addOdometry(2.0, Pose2D(std::nan(""), 0.0, 0.0)), SampleVerdict::kInvalid);
   EXPECT_EQ(pipeline.newestOdometryStamp(), 1.0) << "rejected samples do not count";
   EXPECT_TRUE(pipeline.odometryStalled()) << "rejected samples do not revive it either";
-  ASSERT_TRUE(pipeline.addOdometry(1.1, Pose2D()));
+  ASSERT_EQ(pipeline.addOdometry(1.1, Pose2D()), SampleVerdict::kTaken);
   EXPECT_FALSE(pipeline.odometryStalled()) << "a new sample: it moves again";
   EXPECT_FALSE(pipeline.inputsReadyFor(5.0));
-  ASSERT_TRUE(pipeline.addOdometry(0.5, Pose2D()));
-  EXPECT_EQ(pipeline.newestOdometryStamp(), 1.1) << "a late, older sample does not move the newest stamp";
+  EXPECT_EQ(pipeline.addOdometry(0.5, Pose2D()), SampleVerdict::kStale) << "older than the newest: dropped";
+  EXPECT_EQ(pipeline.newestOdometryStamp(), 1.1) << "a dropped sample does not move the newest stamp";
 }
 
 TEST(OdometryPipeline, NeverWaitsWhenOdometryIsOffOrWaitingDisabled) {
@@ -87,20 +88,20 @@ TEST(OdometryPipeline, WithUseImuTheImuIsWaitedForAndStallsOnItsOwn) {
   TrackerOptions options;
   options.use_imu = true;
   OdometryPipeline pipeline(options);
-  ASSERT_TRUE(pipeline.addOdometry(1.0, Pose2D()));
+  ASSERT_EQ(pipeline.addOdometry(1.0, Pose2D()), SampleVerdict::kTaken);
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0)) << "no IMU sample yet: nothing to wait for";
-  ASSERT_TRUE(pipeline.addImu(0.95, 0.0));
+  ASSERT_EQ(pipeline.addImu(0.95, 0.0), SampleVerdict::kTaken);
   EXPECT_FALSE(pipeline.inputsReadyFor(1.0)) << "the wheels are there, the IMU's sample is still to come";
-  ASSERT_TRUE(pipeline.addImu(1.0, 0.0));
+  ASSERT_EQ(pipeline.addImu(1.0, 0.0), SampleVerdict::kTaken);
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0));
-  ASSERT_TRUE(pipeline.addOdometry(2.0, Pose2D()));
+  ASSERT_EQ(pipeline.addOdometry(2.0, Pose2D()), SampleVerdict::kTaken);
   pipeline.inputsWaitTimedOut(2.0);
   EXPECT_TRUE(pipeline.imuStalled());
   EXPECT_FALSE(pipeline.odometryStalled()) << "the wheels had their sample";
   EXPECT_TRUE(pipeline.inputsReadyFor(2.0));
-  EXPECT_FALSE(pipeline.addImu(std::nan(""), 0.0));
+  EXPECT_EQ(pipeline.addImu(std::nan(""), 0.0), SampleVerdict::kInvalid);
   EXPECT_TRUE(pipeline.imuStalled()) << "a rejected sample does not revive it";
-  ASSERT_TRUE(pipeline.addImu(1.5, 0.0));
+  ASSERT_EQ(pipeline.addImu(1.5, 0.0), SampleVerdict::kTaken);
   EXPECT_FALSE(pipeline.imuStalled());
   EXPECT_FALSE(pipeline.inputsReadyFor(2.0));
 }
@@ -127,29 +128,6 @@ TEST(OdometryPipeline, ReplayAddsWhatTheLiveNodeHoldsAfterItsWait) {
   OdometryPipeline off(no_odometry);
   EXPECT_EQ(off.addRecordedOdometry(samples.begin(), samples.end(), 1.0), samples.end());
   EXPECT_EQ(off.newestOdometryStamp(), -std::numeric_limits<double>::infinity()) << "nothing added";
-}
-
-TEST(OdometryPipeline, AngleIncrementChangeAtTheSameBeamCountMakesOneKeyframeAndOneWarning) {
-  TrackerOptions options;
-  options.use_odometry = false;
-  OdometryPipeline pipeline(options);
-  const hglasm_test::LaserSpec narrow = hglasm_test::laserSpec(hglasm_test::deg(170.0), 361);
-  const hglasm_test::LaserSpec wide = hglasm_test::laserSpec(hglasm_test::deg(180.0), 361);
-  double t = 0.0;
-  const auto step = [&](const hglasm_test::LaserSpec& spec) {
-    t += 0.1;
-    return pipeline.processScan(t, rangesAt(straightAt(t), false, spec));
-  };
-  step(narrow);
-  const PipelineUpdate same = step(narrow);
-  EXPECT_TRUE(same.geometry_warning.empty());
-  EXPECT_FALSE(same.tracker.new_keyframe) << "5 cm from the keyframe";
-  const PipelineUpdate changed = step(wide);
-  EXPECT_NE(changed.geometry_warning.find("angle_increment"), std::string::npos) << changed.geometry_warning;
-  EXPECT_TRUE(changed.tracker.new_keyframe);
-  const PipelineUpdate after = step(wide);
-  EXPECT_TRUE(after.geometry_warning.empty()) << "one warning per change";
-  EXPECT_FALSE(after.tracker.new_keyframe);
 }
 
 TEST(OdometryPipeline, ScanErrorChangesAreReportedOnce) {
@@ -182,14 +160,14 @@ TEST(OdometryPipeline, ImuStalenessChangesAreReportedOnce) {
   for (int k = 1; k <= 8; ++k) {
     for (; next <= 20 * k; ++next) {
       if (sent(next)) {
-        ASSERT_TRUE(pipeline.addImu(0.005 * next, 0.0));
+        ASSERT_EQ(pipeline.addImu(0.005 * next, 0.0), SampleVerdict::kTaken);
       }
     }
     const PipelineUpdate update = pipeline.processScan(0.1 * k, scan);
     stale.push_back(update.imu_stale);
     changed.push_back(update.imu_stale_changed);
   }
-  EXPECT_FALSE(pipeline.addImu(std::nan(""), 0.0));
+  EXPECT_EQ(pipeline.addImu(std::nan(""), 0.0), SampleVerdict::kInvalid);
   // 0.2, 0.3: covered; 0.4: 0.08 s past the last sample, within max_gap; 0.5, 0.6: the gap 0.32-0.58 lies
   // in their steps; 0.7, 0.8: covered again.
   EXPECT_EQ(stale, std::vector<bool>({false, false, false, false, true, true, false, false}));
@@ -201,11 +179,11 @@ TEST(OdometryPipeline, TheImuIsWaitedForToTheEndOfTheSweep) {
   TrackerOptions options;
   options.use_imu = true;
   OdometryPipeline pipeline(options);
-  ASSERT_TRUE(pipeline.addOdometry(1.0, Pose2D()));
-  ASSERT_TRUE(pipeline.addImu(1.05, 0.0));
+  ASSERT_EQ(pipeline.addOdometry(1.0, Pose2D()), SampleVerdict::kTaken);
+  ASSERT_EQ(pipeline.addImu(1.05, 0.0), SampleVerdict::kTaken);
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0));
   EXPECT_FALSE(pipeline.inputsReadyFor(1.0, 0.1));
-  ASSERT_TRUE(pipeline.addImu(1.1, 0.0));
+  ASSERT_EQ(pipeline.addImu(1.1, 0.0), SampleVerdict::kTaken);
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0, 0.1));
   EXPECT_FALSE(pipeline.inputsReadyFor(1.0, 0.2));
   pipeline.inputsWaitTimedOut(1.0, 0.2);
@@ -220,22 +198,22 @@ TEST(OdometryPipeline, AStalledInputIsRevivedOnlyBySamplesAtOrAfterTheLastScan) 
   options.use_imu = true;
   OdometryPipeline pipeline(options);
   const hglasm::RangeScan scan = rangesAt(Pose2D(), false);
-  ASSERT_TRUE(pipeline.addImu(0.5, 0.0));
+  ASSERT_EQ(pipeline.addImu(0.5, 0.0), SampleVerdict::kTaken);
   ASSERT_FALSE(pipeline.inputsReadyFor(1.0));
   pipeline.inputsWaitTimedOut(1.0);
   EXPECT_TRUE(pipeline.imuStalled());
   pipeline.processScan(1.0, scan);
-  ASSERT_TRUE(pipeline.addImu(0.8, 0.0));  // late: older than the scan already processed
+  ASSERT_EQ(pipeline.addImu(0.8, 0.0), SampleVerdict::kTaken);  // late: older than the scan already processed
   EXPECT_TRUE(pipeline.imuStalled());
   EXPECT_TRUE(pipeline.inputsReadyFor(1.1)) << "not waited for";
-  ASSERT_TRUE(pipeline.addImu(1.0, 0.0));  // caught up with the scans
+  ASSERT_EQ(pipeline.addImu(1.0, 0.0), SampleVerdict::kTaken);  // caught up with the scans
   EXPECT_FALSE(pipeline.imuStalled());
   EXPECT_FALSE(pipeline.inputsReadyFor(1.1));
 }
 
 TEST(OdometryPipeline, WithoutUseImuNothingIsStale) {
   OdometryPipeline pipeline;
-  EXPECT_FALSE(pipeline.addImu(0.0, 1.0));
+  EXPECT_EQ(pipeline.addImu(0.0, 1.0), SampleVerdict::kInvalid);
   const hglasm::RangeScan scan = rangesAt(Pose2D(), false);
   for (int i = 1; i <= 3; ++i) {
     const PipelineUpdate update = pipeline.processScan(0.1 * i, scan);
@@ -373,6 +351,82 @@ TEST(OdometryPipeline, ExposesTheLocalMapInTheOdometryFrameAndItsRevisionPerKeyf
   pipeline.reset();
   pipeline.processScan(2.1, straightScan(2.1, mount));
   EXPECT_NE(pipeline.localMap().revision(), revision) << "a reset rebuilds the map";
+}
+
+}  // namespace
+
+namespace {
+
+TEST(OdometryPipeline, TimePolicyAStaleScanIsDroppedAndWaitsForNothing) {
+  TrackerOptions options;
+  options.use_odometry = false;
+  OdometryPipeline pipeline(options);
+  pipeline.processScan(1.0, straightScan(1.0, Pose2D()));
+  pipeline.processScan(1.1, straightScan(1.1, Pose2D()));
+  const Pose2D before = pipeline.pose();
+  EXPECT_TRUE(pipeline.inputsReadyFor(1.099));
+  const PipelineUpdate stale = pipeline.processScan(1.099, straightScan(1.099, Pose2D()));
+  EXPECT_TRUE(stale.tracker.stale);
+  EXPECT_FALSE(stale.tracker.published);
+  EXPECT_FALSE(stale.tracker.reset);
+  EXPECT_FALSE(stale.jumped_back);
+  EXPECT_NE(stale.tracker.warning.find("before the last one processed"), std::string::npos)
+      << stale.tracker.warning;
+  EXPECT_EQ(pipeline.pose().x, before.x);
+  EXPECT_EQ(pipeline.inputCounts().stale_scans, 1u);
+  const PipelineUpdate next = pipeline.processScan(1.2, straightScan(1.2, Pose2D()));
+  EXPECT_TRUE(next.tracker.published);
+  EXPECT_FALSE(next.tracker.reset);
+}
+
+TEST(OdometryPipeline, TimePolicyOdometryOlderThanItsNewestIsDroppedAndMuchOlderIsANewTimeline) {
+  OdometryPipeline pipeline;
+  ASSERT_EQ(pipeline.addOdometry(10.0, Pose2D()), SampleVerdict::kTaken);
+  EXPECT_EQ(pipeline.addOdometry(9.9, Pose2D()), SampleVerdict::kStale);
+  EXPECT_EQ(pipeline.addOdometry(10.0, Pose2D()), SampleVerdict::kTaken) << "the same stamp again";
+  EXPECT_EQ(pipeline.inputCounts().stale_odometry, 1u);
+  EXPECT_EQ(pipeline.addOdometry(2.0, Pose2D()), SampleVerdict::kNewTimeline);
+  EXPECT_EQ(pipeline.newestOdometryStamp(), 2.0);
+  EXPECT_EQ(pipeline.addOdometry(2.1, Pose2D()), SampleVerdict::kTaken);
+}
+
+TEST(OdometryPipeline, TimePolicyAScanClockThatJumpsBackRestartsAndForgetsTheOldWheels) {
+  // A looped bag: scans and wheels start again 20 s earlier, the scans first. The old timeline's wheels
+  // would make the first predictions jumps; they are forgotten, and the wheels of the new one predict.
+  OdometryPipeline pipeline;
+  for (int i = 0; i <= 20; ++i) {
+    const double t = 0.05 * i;  // seen at t, stamped 20 s later
+    pipeline.addOdometry(20.0 + t, straightAt(t));
+    if (i % 2 == 0) pipeline.processScan(20.0 + t, straightScan(t, Pose2D()));
+  }
+  const PipelineUpdate back = pipeline.processScan(0.0, straightScan(0.0, Pose2D()));
+  EXPECT_TRUE(back.jumped_back);
+  EXPECT_TRUE(back.tracker.reset);
+  EXPECT_NE(back.tracker.warning.find("went back by 21"), std::string::npos) << back.tracker.warning;
+  EXPECT_EQ(pipeline.newestOdometryStamp(), -std::numeric_limits<double>::infinity()) << "forgotten";
+  for (int i = 1; i <= 10; ++i) {
+    const double t = 0.05 * i;
+    EXPECT_EQ(pipeline.addOdometry(t, straightAt(t)), SampleVerdict::kTaken);
+    if (i % 2) continue;
+    const PipelineUpdate update = pipeline.processScan(t, straightScan(t, Pose2D()));
+    EXPECT_EQ(update.tracker.prediction, hglasm::PredictionSource::kOdometry) << t;
+    EXPECT_FALSE(update.tracker.reset);
+    EXPECT_TRUE(update.tracker.warning.empty()) << update.tracker.warning;
+  }
+  EXPECT_NEAR(pipeline.pose().x, straightAt(0.5).x - straightAt(0.0).x, 0.01);
+  EXPECT_EQ(pipeline.inputCounts().jumps_back, 1u);
+}
+
+TEST(OdometryPipeline, LateWheelsAreWaitedForByTheirTimeOffset) {
+  TrackerOptions options;
+  options.odometry_time_offset.estimate = false;
+  options.odometry_time_offset.offset = 0.3;
+  OdometryPipeline pipeline(options);
+  EXPECT_EQ(pipeline.odometryTimeOffset(), 0.3);
+  ASSERT_EQ(pipeline.addOdometry(1.0, Pose2D()), SampleVerdict::kTaken);
+  EXPECT_FALSE(pipeline.inputsReadyFor(1.0)) << "their pose of 1.0 s comes stamped 1.3 s";
+  ASSERT_EQ(pipeline.addOdometry(1.3, Pose2D()), SampleVerdict::kTaken);
+  EXPECT_TRUE(pipeline.inputsReadyFor(1.0));
 }
 
 }  // namespace

@@ -111,9 +111,40 @@ TEST(PoseExtrapolator, OdometryIgnoredWhenDisabledStaleOrCleared) {
   // The newest sample may be extrapolated 0.5 s, not 0.6 s.
   EXPECT_EQ(extrapolator.predict(0.0, 1.5, noise, &warning).source, PredictionSource::kOdometry);
   EXPECT_EQ(extrapolator.predict(0.0, 1.6, noise, &warning).source, PredictionSource::kNone);
-  extrapolator.clearSensorHistory();
+  extrapolator.clearOdometry();
   EXPECT_EQ(extrapolator.predict(0.0, 1.0, noise, &warning).source, PredictionSource::kNone);
   EXPECT_TRUE(warning.empty());
+}
+
+TEST(PoseExtrapolator, TheWheelsAreReadAtTheScansStampPlusTheirTimeOffset) {
+  // Wheels 0.3 s late: their pose of the scans' 1.0 s is the one stamped 1.3 s.
+  const MotionNoiseModel noise;
+  std::string warning;
+  PoseExtrapolator extrapolator = makeExtrapolator();
+  for (int i = 0; i <= 20; ++i) extrapolator.addOdometry(0.1 * i, Pose2D(0.1 * i * 0.1 * i, 0.0, 0.0));
+  extrapolator.setOdometryTimeOffset(0.3);
+  EXPECT_EQ(extrapolator.odometryTimeOffset(), 0.3);
+  const MotionPrediction late = extrapolator.predict(0.5, 1.0, noise, &warning);
+  ASSERT_EQ(late.source, PredictionSource::kOdometry);
+  expectPose(late.motion, 1.3 * 1.3 - 0.8 * 0.8, 0.0, 0.0, 1e-9);
+}
+
+TEST(PoseExtrapolator, WithoutWheelsALongPauseKeepsThePose) {
+  // The velocity is no longer known after kMaxVelocityAge: no motion is predicted over a longer step, and
+  // its noise is that of kMaxVelocityAge (the search is the preset's box).
+  const MotionNoiseModel noise;
+  std::string warning;
+  PoseExtrapolator extrapolator(false, 0.5, 5.0, 6.0);
+  extrapolator.addPose(0.0, Pose2D());
+  extrapolator.addPose(0.5, Pose2D(0.5, 0.0, 0.0));
+  ASSERT_TRUE(extrapolator.velocityKnown());
+  const MotionPrediction short_step = extrapolator.predict(0.5, 1.5, noise, &warning);
+  EXPECT_EQ(short_step.source, PredictionSource::kConstantVelocity);
+  expectPose(short_step.motion, 1.0, 0.0, 0.0);
+  const MotionPrediction pause = extrapolator.predict(0.5, 100.5, noise, &warning);
+  EXPECT_EQ(pause.source, PredictionSource::kNone);
+  expectPose(pause.motion, 0.0, 0.0, 0.0);
+  EXPECT_EQ(pause.covariance, noise.constantVelocityCovariance(PoseExtrapolator::kMaxVelocityAge));
 }
 
 PoseExtrapolator makeGyroExtrapolator(bool use_odometry = true) {
@@ -213,8 +244,8 @@ TEST(PoseExtrapolator, StaleOrMissingGyroLeavesTheWheelsPrediction) {
   EXPECT_FALSE(stale.gyro);
   expectPose(stale.motion, 1.0, 0.0, 0.3);
   EXPECT_TRUE(extrapolator.predict(0.0, 0.55, noise, &warning).gyro) << "within max_gap of the newest sample";
-  extrapolator.clearSensorHistory();
-  EXPECT_FALSE(extrapolator.predict(0.0, 0.5, noise, &warning).gyro) << "cleared with the odometry";
+  extrapolator.clearGyro();
+  EXPECT_FALSE(extrapolator.predict(0.0, 0.5, noise, &warning).gyro) << "cleared";
 }
 
 TEST(PoseExtrapolator, GyroSamplesAreIgnoredWithoutUseGyro) {

@@ -97,6 +97,9 @@ hglasm::PipelineUpdate matchedUpdate() {
   update.leap_probability = 0.25;
   update.noise_scale.xy = 2.0;
   update.noise_scale.theta = 0.5;
+  update.odometry_time_offset = 0.125;
+  update.odometry_time_offset_estimate = 0.25;
+  update.reanchored = true;
   result.laser_guess = hglasm::Pose2D(0.375, 0.25, 0.0);
   result.scan.points.resize(300);
   result.scan.invalid_count = 60;
@@ -135,10 +138,23 @@ TEST(MatchMsg, AttemptedMatch) {
   EXPECT_EQ(match.leap_probability, 0.25f);
   EXPECT_EQ(match.noise_scale_xy, 2.0f);
   EXPECT_EQ(match.noise_scale_theta, 0.5f);
+  EXPECT_EQ(match.odometry_time_offset, 0.125f);
+  EXPECT_EQ(match.odometry_time_offset_estimate, 0.25f);
+  EXPECT_TRUE(match.reanchored);
   EXPECT_EQ(match.valid_points, 300u);
   EXPECT_EQ(match.invalid_points, 60u);
   EXPECT_EQ(match.total_ms, 12.5f);
   EXPECT_EQ(match.dropped_scans, 4u);
+}
+
+TEST(MatchMsg, AStaleScanSaysSo) {
+  hglasm::PipelineUpdate result;
+  result.tracker.stale = true;
+  const Match match = matchMsgFromUpdate(result, makeHeader(3.0, "laser"), 0.0, 0);
+  EXPECT_EQ(match.status, Match::STATUS_STALE);
+  EXPECT_EQ(match.status_text, "stale");
+  EXPECT_FALSE(match.matched);
+  EXPECT_FALSE(match.reset);
 }
 
 TEST(MatchMsg, NoPosesWithoutAnAttemptedMatch) {

@@ -277,6 +277,47 @@ TEST(Parameters, UnknownKeysAreWarningsNotErrors) {
   EXPECT_NE(warnings[1].find("~genetic/populaton"), std::string::npos) << warnings[1];
 }
 
+TEST(Parameters, TheTimePolicyAndTheWheelsTimeOffsetAreReadAndValidated) {
+  LaserOdometryOptions options;
+  std::string error;
+  ASSERT_TRUE(loadOptions(XmlRpcValue(), &options, &error)) << error;
+  EXPECT_TRUE(options.tracker.odometry_time_offset.estimate) << "auto by default";
+  EXPECT_EQ(options.tracker.odometry_time_offset.max_offset, 1.0);
+  EXPECT_EQ(options.tracker.reset_on_jump_back, 3.0);
+  ASSERT_TRUE(loadOptions(params({{"odometry/time_offset", "auto"}, {"odometry/max_time_offset", 2.0}}),
+                          &options, &error))
+      << error;
+  EXPECT_TRUE(options.tracker.odometry_time_offset.estimate);
+  EXPECT_EQ(options.tracker.odometry_time_offset.max_offset, 2.0);
+  ASSERT_TRUE(
+      loadOptions(params({{"odometry/time_offset", 0.3}, {"time/reset_on_jump_back", 10}}), &options, &error))
+      << error;
+  EXPECT_FALSE(options.tracker.odometry_time_offset.estimate) << "a number fixes it";
+  EXPECT_EQ(options.tracker.odometry_time_offset.offset, 0.3);
+  EXPECT_EQ(options.tracker.reset_on_jump_back, 10.0);
+  ASSERT_TRUE(loadOptions(params({{"odometry/time_offset", -1}}), &options, &error)) << error;
+  EXPECT_EQ(options.tracker.odometry_time_offset.offset, -1.0);
+  for (const XmlRpcValue& bad : {XmlRpcValue("automatic"), XmlRpcValue(11.0), XmlRpcValue(true)}) {
+    const std::string error_text = loadError(params({{"odometry/time_offset", bad}}));
+    EXPECT_NE(error_text.find("~odometry/time_offset must be auto or a number of seconds"), std::string::npos)
+        << error_text;
+  }
+  EXPECT_NE(loadError(params({{"time/reset_on_jump_back", 0.0}})).find("~time/reset_on_jump_back"),
+            std::string::npos);
+  EXPECT_NE(loadError(params({{"odometry/max_time_offset", -0.5}})).find("~odometry/max_time_offset"),
+            std::string::npos);
+}
+
+TEST(Parameters, TheRetiredMaxTimeJumpSaysWhatReplacedIt) {
+  LaserOdometryOptions options;
+  std::string error;
+  std::vector<std::string> warnings;
+  ASSERT_TRUE(loadOptions(params({{"max_time_jump", 60.0}}), &options, &error, &warnings)) << error;
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("~max_time_jump is no longer used"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("~time/reset_on_jump_back"), std::string::npos) << warnings[0];
+}
+
 TEST(Parameters, ToParamsIsWhatLoadOptionsReadsBack) {
   LaserOdometryOptions options;
   std::string error;
@@ -287,6 +328,7 @@ TEST(Parameters, ToParamsIsWhatLoadOptionsReadsBack) {
                                   {"mbicp/point_to_line", false},
                                   {"scan/max_range", 12.5},
                                   {"use_odom", false},
+                                  {"odometry/time_offset", 0.2},
                                   {"base_frame", "/base"}}),
                           &options, &error))
       << error;
@@ -295,6 +337,7 @@ TEST(Parameters, ToParamsIsWhatLoadOptionsReadsBack) {
   EXPECT_EQ(static_cast<int>(written["genetic"]["elite_count"]), 2);
   EXPECT_EQ(static_cast<bool>(written["use_odom"]), false);
   EXPECT_EQ(static_cast<std::string>(written["base_frame"]), "base");
+  EXPECT_EQ(static_cast<double>(written["odometry"]["time_offset"]), 0.2);
   std::vector<std::string> warnings;
   LaserOdometryOptions again;
   ASSERT_TRUE(loadOptions(written, &again, &error, &warnings)) << error;

@@ -19,6 +19,11 @@
 //   min_deskewed_ratio / max_deskewed_ratio  bounds on the fraction of matches that were de-skewed
 //                          (defaults 0 and 1)
 //   timeout                wall seconds for the whole replay (default 100)
+//   rate                   the player's rate (the offline replay's waits for odometry last as long in bag
+//   time) stale_scans            scans of the bag stamped before one played ahead of them (default 0): the
+//   node
+//                          drops them (~match says stale, nothing on ~odom and tf), as the offline replay
+//                          does
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -49,10 +54,12 @@
 #include "hglasm_odometry/core/odometry_buffer.h"
 #include "hglasm_odometry/core/odometry_pipeline.h"
 #include "hglasm_odometry/core/scan_matcher.h"
+#include "hglasm_odometry/core/stamp_order.h"
 #include "hglasm_odometry/evaluation/relations.h"
 #include "hglasm_odometry/ros/conversions.h"
 #include "hglasm_odometry/ros/parameters.h"
 #include "hglasm_odometry/tools/bag_reader.h"
+#include "hglasm_odometry/tools/bag_replay.h"
 
 namespace hglasm_odometry {
 namespace {
@@ -76,12 +83,15 @@ struct Settings {
   double min_deskewed_ratio = 0.0;
   double max_deskewed_ratio = 1.0;
   double timeout = 100.0;
+  double rate = 1.0;
+  int stale_scans = 0;
 };
 
 /// Everything recorded during one replay; shared by the tests below.
 struct Recording {
   Settings settings;
   std::vector<ros::Time> scan_stamps;               // from the bag, sorted
+  std::vector<ros::Time> published_stamps;          // those the time policy keeps (not stale), sorted
   std::vector<hglasm::StampedPose> wheel_odometry;  // from the bag, at the scan stamps
   std::vector<nav_msgs::Odometry> odometry;
   std::vector<Match> matches;
@@ -128,19 +138,27 @@ Settings readSettings() {
   private_nh.getParam("min_deskewed_ratio", s.min_deskewed_ratio);
   private_nh.getParam("max_deskewed_ratio", s.max_deskewed_ratio);
   private_nh.getParam("timeout", s.timeout);
+  private_nh.getParam("rate", s.rate);
+  private_nh.getParam("stale_scans", s.stale_scans);
   return s;
 }
 
-/// The bag's scan stamps (sorted) and its wheel odometry at those stamps.
+/// The bag's scan stamps (sorted; and those the time policy keeps, in the order played) and its wheel
+/// odometry at those stamps.
 void readScanStampsAndWheelOdometry(Recording* rec) {
   const Settings& s = rec->settings;
   hglasm::OdometryBuffer wheel(1e9);
+  hglasm::StampOrder order(hglasm::TrackerOptions().reset_on_jump_back);
   {
     rosbag::Bag bag(s.bag, rosbag::bagmode::Read);
     for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
       if (m.getTopic() == s.scan_topic) {
-        if (auto scan = m.instantiate<sensor_msgs::LaserScan>())
+        if (auto scan = m.instantiate<sensor_msgs::LaserScan>()) {
           rec->scan_stamps.push_back(scan->header.stamp);
+          if (order.take(scan->header.stamp.toSec()) != hglasm::StampOrder::Verdict::kStale) {
+            rec->published_stamps.push_back(scan->header.stamp);
+          }
+        }
       } else if (m.getTopic() == s.wheel_odom_topic) {
         hglasm::Pose2D pose;
         auto odom = m.instantiate<nav_msgs::Odometry>();
@@ -149,6 +167,7 @@ void readScanStampsAndWheelOdometry(Recording* rec) {
     }
   }
   std::sort(rec->scan_stamps.begin(), rec->scan_stamps.end());
+  std::sort(rec->published_stamps.begin(), rec->published_stamps.end());
   for (const ros::Time& stamp : rec->scan_stamps) {
     hglasm::StampedPose pose;
     pose.stamp = stamp.toSec();
@@ -159,16 +178,18 @@ void readScanStampsAndWheelOdometry(Recording* rec) {
 /// Until every scan has its odometry, match and tf, or nothing arrived for a while, or the time is up.
 template <typename Elapsed>
 void waitForEveryScan(Recording* rec, const Elapsed& elapsed) {
-  const std::size_t expected = rec->scan_stamps.size();
   std::size_t last_count = 0;
   ros::WallTime last_progress = ros::WallTime::now();
   while (ros::ok() && elapsed() < rec->settings.timeout) {
     std::size_t count;
+    bool complete;
     {
       std::lock_guard<std::mutex> lock(rec->mutex);
-      count = std::min(rec->odometry.size(), std::min(rec->matches.size(), rec->transforms.size()));
+      count = rec->odometry.size() + rec->matches.size() + rec->transforms.size();
+      complete = rec->matches.size() >= rec->scan_stamps.size() &&
+                 std::min(rec->odometry.size(), rec->transforms.size()) >= rec->published_stamps.size();
     }
-    if (count >= expected) break;
+    if (complete) break;
     if (count != last_count) {
       last_count = count;
       last_progress = ros::WallTime::now();
@@ -265,6 +286,9 @@ std::unique_ptr<Recording> OdometryReplay::recording_;
 TEST_F(OdometryReplay, PlayerStartedAndTheBagHasScans) {
   EXPECT_TRUE(recording_->started) << "could not resume " << recording_->settings.player;
   EXPECT_GT(recording_->scan_stamps.size(), 100u);
+  EXPECT_EQ(recording_->scan_stamps.size() - recording_->published_stamps.size(),
+            static_cast<std::size_t>(recording_->settings.stale_scans))
+      << "scans stamped before one played ahead of them";
 }
 
 TEST_F(OdometryReplay, OneOdometryPerScanStampedWithTheScanStamp) {
@@ -275,10 +299,9 @@ TEST_F(OdometryReplay, OneOdometryPerScanStampedWithTheScanStamp) {
     EXPECT_EQ(stripLeadingSlash(odom.header.frame_id), r.settings.odom_frame);
     EXPECT_EQ(stripLeadingSlash(odom.child_frame_id), r.settings.base_frame);
   }
-  ASSERT_EQ(stamps.size(), r.scan_stamps.size()) << "odometry messages vs scans in the bag";
+  ASSERT_EQ(stamps.size(), r.published_stamps.size()) << "odometry messages vs scans in the bag, not stale";
   EXPECT_TRUE(std::is_sorted(stamps.begin(), stamps.end())) << "odometry published out of order";
-  std::sort(stamps.begin(), stamps.end());
-  EXPECT_EQ(stamps, r.scan_stamps) << "odometry stamps differ from the scan stamps";
+  EXPECT_EQ(stamps, r.published_stamps) << "odometry stamps differ from the scan stamps";
 }
 
 TEST_F(OdometryReplay, OneMatchPerScanStampedWithTheScanStamp) {
@@ -290,15 +313,18 @@ TEST_F(OdometryReplay, OneMatchPerScanStampedWithTheScanStamp) {
     max_dropped = std::max(max_dropped, match.dropped_scans);
   }
   std::sort(stamps.begin(), stamps.end());
-  EXPECT_EQ(stamps, r.scan_stamps);
+  EXPECT_EQ(stamps, r.scan_stamps) << "one ~match per scan, stale ones too";
   EXPECT_EQ(max_dropped, 0u) << "the input queue dropped scans";
+  const auto stale = std::count_if(r.matches.begin(), r.matches.end(),
+                                   [](const Match& m) { return m.status == Match::STATUS_STALE; });
+  EXPECT_EQ(stale, r.settings.stale_scans);
   ASSERT_FALSE(r.matches.empty());
   EXPECT_TRUE(r.matches.front().reset) << "the first scan starts the odometry";
 }
 
 TEST_F(OdometryReplay, TfForEveryScanEqualsTheOdometry) {
   const Recording& r = *recording_;
-  ASSERT_EQ(r.transforms.size(), r.scan_stamps.size())
+  ASSERT_EQ(r.transforms.size(), r.published_stamps.size())
       << r.settings.odom_frame << " -> " << r.settings.base_frame;
   for (const auto& odom : r.odometry) {
     auto it = r.transforms.find(odom.header.stamp);
@@ -528,20 +554,21 @@ struct OfflineScan {
   std::optional<hglasm::Pose2D> laser_guess;
 };
 
-/// The offline pipeline over the bag, with the node's parameters (from its private namespace) and the
-/// feeding policy evaluate uses, by scan stamp.
+/// The offline pipeline over the bag as evaluate runs it (replayBag: the bag's order, the node's waits at
+/// the player's rate), with the node's parameters, by scan stamp.
 std::map<double, OfflineScan> runOffline(const Settings& settings) {
   LaserOdometryOptions options;
   const BagData data = readReplayedBag(settings, &options);
   hglasm::OdometryPipeline pipeline(options.tracker, options.odometry_wait > 0.0);
   setLaserMount(data, &pipeline);
+  ReplayOptions replay;
+  replay.odometry_wait = options.odometry_wait;
+  replay.rate = settings.rate;
+  replay.queue_size = static_cast<std::size_t>(options.queue_size);
   std::map<double, OfflineScan> run;
-  auto next_odometry = data.odometry.begin();
-  for (const BagScan& scan : data.scans) {
-    next_odometry = pipeline.addRecordedOdometry(next_odometry, data.odometry.end(), scan.stamp);
-    const hglasm::PipelineUpdate result = pipeline.processScan(scan.stamp, scan.ranges);
-    run[scan.stamp] = OfflineScan{result.tracker, result.laser_guess};
-  }
+  replayBag(data, &pipeline, replay, [&run](const ReplayedScan& replayed) {
+    run[replayed.scan->stamp] = OfflineScan{replayed.update.tracker, replayed.update.laser_guess};
+  });
   return run;
 }
 
@@ -557,17 +584,18 @@ std::uint8_t predictionSourceOf(const hglasm::TrackerUpdate& update) {
   return Match::PREDICTION_NONE;
 }
 
-/// The node and the offline pipeline (the one evaluate runs) agree pose by pose: both obey the pipeline's
-/// odometry-feeding policy, so the tracker sees the same odometry around every scan, and the rest is
-/// deterministic. Measured bit-identical (position, and the quaternion the node publishes); the tolerance
-/// only leaves room for rounding (a mount composed by tf2 and by readBag in another order), while a
-/// different odometry sample or a missed keyframe moves poses by millimetres at least.
+/// The node and the offline replay (the one evaluate runs) agree pose by pose: both take the bag's messages
+/// in the order played and wait for odometry as long (in bag time), so the tracker sees the same scans
+/// (the same stale ones dropped) and the same odometry around every scan, and the rest is deterministic.
+/// Measured bit-identical (position, and the quaternion the node publishes); the tolerance only leaves room
+/// for rounding (a mount composed by tf2 and by readBag in another order), while a different odometry sample
+/// or a missed keyframe moves poses by millimetres at least.
 TEST_F(OdometryReplay, OfflinePipelineGivesTheSameTrajectory) {
   constexpr double kTolerance = 1e-9;  // metres and radians
   const Recording& r = *recording_;
   const std::map<double, OfflineScan> offline = runOffline(r.settings);
   ASSERT_EQ(offline.size(), r.scan_stamps.size());
-  ASSERT_EQ(r.odometry.size(), r.scan_stamps.size()) << "the node did not process every scan";
+  ASSERT_EQ(r.odometry.size(), r.published_stamps.size()) << "the node did not process every scan";
 
   double max_translation = 0.0, max_rotation = 0.0, max_guess = 0.0;
   int first_different = -1, index = 0, identical = 0;
@@ -596,6 +624,7 @@ TEST_F(OdometryReplay, OfflinePipelineGivesTheSameTrajectory) {
     EXPECT_EQ(match.keyframe_id, static_cast<std::uint32_t>(update.keyframe_id)) << match.header.stamp;
     EXPECT_EQ(match.fallback, update.fallback) << match.header.stamp;
     EXPECT_EQ(match.prediction_source, predictionSourceOf(update)) << match.header.stamp;
+    EXPECT_EQ(match.status == Match::STATUS_STALE, update.stale) << match.header.stamp;
     ASSERT_EQ(it->second.laser_guess.has_value(), static_cast<bool>(match.matched)) << match.header.stamp;
     if (!it->second.laser_guess) continue;
     const hglasm::Pose2D& guess = *it->second.laser_guess;

@@ -60,7 +60,9 @@ inline std::string describe(const Match& m) {
   text << "match @" << m.header.stamp << ": status " << m.status_text << " matched " << int(m.matched)
        << " fallback " << int(m.fallback) << " keyframe " << int(m.new_keyframe) << " reset " << int(m.reset)
        << " prediction " << int(m.prediction_source) << " fitness " << m.fitness_ratio << " valid "
-       << m.valid_points << " invalid " << m.invalid_points << " dropped " << m.dropped_scans;
+       << m.valid_points << " invalid " << m.invalid_points << " dropped " << m.dropped_scans
+       << " odometry time offset " << m.odometry_time_offset << " (estimate "
+       << m.odometry_time_offset_estimate << ")";
   return text.str();
 }
 
@@ -266,6 +268,7 @@ class Robot {
         [this, index] {
           std::lock_guard<std::mutex> lock(mutex_);
           if (match_.size() <= index) return false;
+          if (match_[index].status == Match::STATUS_STALE) return true;  // dropped: no pose comes with it
           const ros::Time stamp = match_[index].header.stamp;
           return std::any_of(odom_.begin(), odom_.end(),
                              [&stamp](const nav_msgs::Odometry& o) { return o.header.stamp == stamp; });

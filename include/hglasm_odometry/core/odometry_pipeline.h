@@ -11,6 +11,7 @@
 #include "hglasm_odometry/core/odometry_tracker.h"
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
+#include "hglasm_odometry/core/stamp_order.h"
 
 namespace hglasm {
 
@@ -27,9 +28,9 @@ struct PipelineUpdate {
   /// scan_error differs from the previous scan's (the first scan counts as following a valid one): log
   /// once per change of state, not per scan.
   bool scan_error_changed = false;
-  /// Non-empty when the scan's angle_increment changed at an unchanged beam count: the scan was made a
-  /// keyframe (a beam-count change the tracker notices itself, in tracker.warning).
-  std::string geometry_warning;
+  /// The scan's stamp lay more than reset_on_jump_back behind the last one's: a new timeline, the odometry
+  /// restarted from the origin (tracker.reset, tracker.warning says so).
+  bool jumped_back = false;
   /// Set when a match was attempted: the predicted pose of the new laser in the keyframe's laser frame,
   /// the guess the search was centred on.
   std::optional<Pose2D> laser_guess;
@@ -41,18 +42,39 @@ struct PipelineUpdate {
   double conversion_cpu_ms = 0.0;  ///< CPU time of the scan conversion (calling thread)
 };
 
+/// What became of one wheel-odometry or IMU sample (the time policy below).
+enum class SampleVerdict { kTaken, kInvalid, kStale, kNewTimeline };
+const char* toString(SampleVerdict verdict);
+
+/// Samples and scans the time policy dropped, and the clock jumps it restarted on, since construction.
+struct InputCounts {
+  std::uint64_t stale_scans = 0;
+  std::uint64_t stale_odometry = 0;
+  std::uint64_t stale_imu = 0;
+  std::uint64_t jumps_back = 0;  ///< of the scans' clock: the odometry restarted
+};
+
 /// Not thread-safe per instance (callers with several threads guard it with one mutex); instances share
 /// nothing.
 ///
+/// Time policy (one per input stream: scans, wheel odometry, IMU; StampOrder): a message stamped before the
+/// newest one of its stream is dropped (a driver's jitter, a reordered bag; counted, and a stale scan is
+/// reported in its update), never a reset. One stamped more than reset_on_jump_back behind is a clock that
+/// went back (a looped bag, a restarted clock): for scans the odometry restarts from the origin with a
+/// warning, and samples of the other streams still on the old timeline are forgotten; a wheel or IMU
+/// sample starts its stream's new timeline. A forward gap of any length continues from the current pose,
+/// predicted by the wheels when their samples cover it.
+///
 /// Wheel-odometry feeding policy (both the live node and offline replays obey it, so the tracker sees
 /// the same samples around every scan): a scan stamped t is processed once inputsReadyFor(t), i.e.
-/// once a sample stamped at or after t has been added, so the prediction at t is interpolated between
-/// the two samples around it, never extrapolated, even across a gap in the data. It is not waited for
-/// when odometry is off, when none has been added yet, or while odometry is stalled: a live node bounds
-/// each wait in wall time (odometry/wait) and reports a wait that timed out (inputsWaitTimedOut());
-/// scans then go on without waiting until the next sample arrives. Samples added beyond the first one
-/// at or after t change nothing: interpolation only uses the two around t. With use_imu the IMU's samples
-/// are waited for the same way, and stall on their own.
+/// once a sample stamped at or after t + the wheels' time offset has been added, so the prediction at t
+/// is interpolated between the two samples around it, never extrapolated, even across a gap in the data.
+/// It is not waited for when odometry is off, when none has been added yet, or while odometry is stalled:
+/// a live node bounds each wait in wall time (odometry/wait) and reports a wait that timed out
+/// (inputsWaitTimedOut()); scans then go on without waiting until a sample arrives that the last scan
+/// processed would have waited for. Samples added beyond the first one at or after t change nothing:
+/// interpolation only uses the two around t. With use_imu the IMU's samples are waited for the same way,
+/// and stall on their own.
 class OdometryPipeline {
  public:
   /// `wait_for_odometry` false: scans never wait for odometry (a live node with odometry/wait 0).
@@ -62,25 +84,29 @@ class OdometryPipeline {
   /// A non-finite mount is ignored (false).
   bool setLaserMount(const Pose2D& base_to_laser, bool upside_down);
 
-  /// Wheel odometry: pose of the base in the wheel-odometry frame at `stamp`. Non-finite samples are
-  /// ignored (false).
-  bool addOdometry(double stamp, const Pose2D& pose);
+  /// Wheel odometry: pose of the base in the wheel-odometry frame at `stamp` (time policy above).
+  /// Non-finite samples are kInvalid.
+  SampleVerdict addOdometry(double stamp, const Pose2D& pose);
 
-  /// IMU: the base's yaw rate (rad/s), or its yaw (rad) with imu.use_orientation, at `stamp`; ignored
-  /// (false) without use_imu or for non-finite values.
-  bool addImu(double stamp, double value);
+  /// IMU: the base's yaw rate (rad/s), or its yaw (rad) with imu.use_orientation, at `stamp` (time policy
+  /// above); kInvalid without use_imu or for non-finite values.
+  SampleVerdict addImu(double stamp, double value);
 
   /// Stamp of the newest odometry sample added; -infinity before the first.
-  double newestOdometryStamp() const { return wheels_.newest; }
+  double newestOdometryStamp() const { return wheels_.order.newest(); }
+  /// Seconds the wheels' stamps run late against the scans' (learned, or odometry/time_offset).
+  double odometryTimeOffset() const { return tracker_.odometryTimeOffset(); }
+  InputCounts inputCounts() const;
 
-  /// The feeding policy (see the class comment): true once a scan stamped `stamp` may be processed. The
-  /// IMU is waited for to the end of the scan's sweep (`sweep` seconds after the stamp; scanSweepTime):
-  /// de-skewing takes its turn during the sweep.
+  /// The feeding policy (see the class comment): true once a scan stamped `stamp` may be processed (the
+  /// wheels are waited for to `stamp` plus their time offset). The IMU is waited for to the end of the
+  /// scan's sweep (`sweep` seconds after the stamp; scanSweepTime): de-skewing takes its turn during the
+  /// sweep. A scan the time policy will drop waits for nothing.
   bool inputsReadyFor(double stamp, double sweep = 0.0) const;
 
   /// A live wait for a scan at `stamp` timed out: the wheel odometry, the IMU or both (whichever had no
-  /// sample at or after it) count as stalled until a sample of theirs arrives stamped at or after the
-  /// newest scan processed: one that lags by more than the wait is not waited for at every scan.
+  /// sample at or after it) count as stalled until a sample of theirs arrives that the newest scan
+  /// processed waited for: one that lags by more than the wait is not waited for at every scan.
   void inputsWaitTimedOut(double stamp, double sweep = 0.0);
   bool odometryStalled() const { return wheels_.stalled; }
   bool imuStalled() const { return imu_.stalled; }
@@ -94,13 +120,15 @@ class OdometryPipeline {
   template <typename Iterator>
   Iterator addRecordedOdometry(Iterator next, Iterator end, double stamp) {
     if (!tracker_.options().use_odometry) return end;
-    for (; next != end && next->stamp <= stamp; ++next) addOdometry(next->stamp, next->pose);
+    const double wheel_stamp = stamp + odometryTimeOffset();
+    for (; next != end && next->stamp <= wheel_stamp; ++next) addOdometry(next->stamp, next->pose);
     for (; next != end && !inputsReadyFor(stamp); ++next) addOdometry(next->stamp, next->pose);
     return next;
   }
 
-  /// Converts and processes one scan taken at `stamp` (seconds). If `population` is given, it receives
-  /// the GA's final population as base poses in the odometry frame.
+  /// Converts and processes one scan taken at `stamp` (seconds), under the time policy (a stale scan is
+  /// not processed: tracker.stale). If `population` is given, it receives the GA's final population as
+  /// base poses in the odometry frame.
   PipelineUpdate processScan(double stamp, const RangeScan& ranges,
                              std::vector<Pose2D>* population = nullptr);
 
@@ -120,32 +148,35 @@ class OdometryPipeline {
   const LocalMap& localMap() const { return tracker_.localMap(); }
 
  private:
-  /// Requests a keyframe when angle_increment changed at an unchanged beam count (returns the warning).
-  std::string checkGeometry(const RangeScan& ranges);
+  /// The update of a scan stamped before the newest one processed (`newest`): dropped, nothing published.
+  PipelineUpdate staleScan(double stamp, double newest) const;
+  /// The scans' clock went back from `newest` to `stamp`: restart, and forget the inputs still on the old
+  /// timeline. Returns the warning.
+  std::string restartTimeline(double stamp, double newest);
 
   OdometryTracker tracker_;
   bool wait_for_inputs_;
   ScanConversionOptions conversion_;
   Pose2D base_to_laser_;
-  /// One input the scans wait for (wheel odometry, the IMU) under the feeding policy.
+  /// One input the scans wait for (wheel odometry, the IMU) under the time and feeding policies.
   struct InputFeed {
-    double newest = -std::numeric_limits<double>::infinity();  ///< stamp of the newest sample added
+    explicit InputFeed(double reset_on_jump_back) : order(reset_on_jump_back) {}
+    StampOrder order;  ///< newest(): the stamp of the newest sample added
     bool stalled = false;
-    /// A sample stamped `stamp` was added; only one at or after the last scan processed revives a stalled
-    /// input (one that lags by more than the wait is not waited for at every scan).
-    void added(double stamp, double last_scan);
+    /// Judges a sample's stamp (time policy). A new timeline, or a sample at or after
+    /// `needed_by_last_scan` (what the last scan processed waited for), revives a stalled input.
+    StampOrder::Verdict take(double stamp, double needed_by_last_scan);
     /// A scan needing samples up to `stamp` may go on: one has come, or none ever did (nothing to wait
     /// for), or the input stalled.
-    bool readyFor(double stamp) const { return !std::isfinite(newest) || stalled || newest >= stamp; }
+    bool readyFor(double stamp) const {
+      return !std::isfinite(order.newest()) || stalled || order.newest() >= stamp;
+    }
   };
   InputFeed wheels_, imu_;
-  double last_scan_stamp_ = -std::numeric_limits<double>::infinity();  // of the last scan processed
+  StampOrder scan_order_;  // newest(): the stamp of the last scan processed
   bool wheelsReadyFor(double stamp) const;
   bool imuReadyFor(double stamp) const;  // the stamp the IMU must reach
 
-  bool have_geometry_ = false;
-  std::size_t beam_count_ = 0;
-  double angle_increment_ = 0.0;
   ScanError scan_error_ = ScanError::kNone;
   bool imu_stale_ = false;
   Pose2D keyframe_pose_;  // base pose of the tracker's current keyframe, for the guess

@@ -15,6 +15,7 @@
 #include "hglasm_odometry/core/pose_extrapolator.h"
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
+#include "hglasm_odometry/core/time_offset_estimator.h"
 
 namespace hglasm {
 
@@ -30,7 +31,12 @@ struct TrackerOptions {
   int min_points = 20;                ///< scans with fewer valid points are not matched
   double fallback_covariance_scale = 100.0;  ///< covariance inflation of a step whose match failed
   double odometry_max_extrapolation = 0.25;  ///< seconds; beyond, wheel odometry counts as stale
-  double max_time_jump = 60.0;               ///< seconds forward between scans that triggers a reset
+  /// The wheels' stamps may run late against the scans': learned from the matches, or fixed.
+  TimeOffsetOptions odometry_time_offset;
+  /// Seconds: a scan, odometry or IMU stamp this far behind the newest of its stream is a clock that jumped
+  /// back (a looped bag, a restarted clock): the odometry restarts from the origin (OdometryPipeline). A
+  /// stamp less far behind is dropped.
+  double reset_on_jump_back = 3.0;
   bool use_odometry = true;
   /// Take the rotation between scans from an IMU (addImu) whenever its samples cover the interval, with
   /// imu's noise model; the wheels (or the velocity) predict the translation, and the rotation while the
@@ -120,8 +126,14 @@ struct TrackerUpdate {
   int keyframe_id = 0;
   int map_keyframes = 0;         ///< keyframes in the local map the scan was matched against
   MotionNoiseScale noise_scale;  ///< the wheel-noise scales learned so far
-  bool reset = false;            ///< the tracker restarted (time jump, first scan after reset())
-  std::string warning;           ///< non-empty: one line for the log
+  /// Seconds the wheels' stamps run late (their pose of the scan's instant was read this much later), and
+  /// the best estimate so far (the offset in use until the evidence for it suffices).
+  double odometry_time_offset = 0.0;
+  double odometry_time_offset_estimate = 0.0;
+  bool reset = false;       ///< the tracker restarted (first scan, after reset() or a clock that jumped back)
+  bool stale = false;       ///< stamped before the last scan processed: not processed, nothing published
+  bool reanchored = false;  ///< the scan did not fit the local map: the map restarted from it
+  std::string warning;      ///< non-empty: one line for the log
 };
 
 /// Not thread-safe per instance; instances share nothing.
@@ -140,12 +152,17 @@ class OdometryTracker {
   /// Ignored (false) without use_imu or for non-finite values.
   bool addImu(double stamp, double value) { return extrapolator_.addGyro(stamp, value); }
 
-  /// Processes one scan (points in the laser frame) taken at `stamp` (seconds). If `population_out` is
-  /// given, it receives the GA's final population as base poses in the odometry frame (for display).
+  /// Processes one scan (points in the laser frame) taken at `stamp` (seconds), at or after the last one
+  /// processed (an older scan is stale: not processed, update.stale). Forward gaps of any length continue
+  /// from the current pose, predicted by the wheels when they cover the gap. If `population_out` is given,
+  /// it receives the GA's final population as base poses in the odometry frame (for display).
   TrackerUpdate processScan(double stamp, const Scan& scan, std::vector<Pose2D>* population_out = nullptr);
 
-  /// Makes the next processed scan a keyframe (e.g. the scanner's geometry changed).
-  void requestKeyframe() { keyframes_.request(); }
+  /// Forgets the wheel odometry or the IMU samples (they belong to another timeline: a clock went back).
+  void clearOdometry() { extrapolator_.clearOdometry(); }
+  void clearImu() { extrapolator_.clearGyro(); }
+  /// Seconds the wheels' stamps run late against the scans' (in use for the predictions).
+  double odometryTimeOffset() const { return time_offset_.offset(); }
 
   /// Restarts from the identity pose with an empty map (odometry history and learned noise kept).
   void reset();
@@ -192,7 +209,11 @@ class OdometryTracker {
     double wrong_probability = 0.0;
   };
 
-  bool handleTime(double stamp, TrackerUpdate* update);
+  /// A scan stamped before the last one processed: not processed (the pipeline drops them; a caller of the
+  /// tracker alone gets the same).
+  bool refuseStale(double stamp, TrackerUpdate* update) const;
+  /// Learns the wheels' time offset from where the scan alone put the base.
+  void learnTimeOffset(double stamp);
   /// The scan motion-compensated to its stamp (its beams' times known, scan/deskew): the sensor's turn
   /// during the sweep from the IMU when it covers the sweep (a turn rate that changes within it, as when
   /// a spin starts), else from the velocity estimate, which also gives the translation. False: no
@@ -247,6 +268,7 @@ class OdometryTracker {
   KeyframePolicy keyframes_;
   MotionNoiseModel noise_;
   GyroBiasEstimator gyro_bias_;
+  TimeOffsetEstimator time_offset_;
   LocalMap local_map_;
   Pose2D laser_mount_;
 

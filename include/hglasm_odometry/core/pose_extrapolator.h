@@ -55,17 +55,26 @@ class PoseExtrapolator {
   /// The IMU's rotation of the base from `from` to `to` (bias removed); false without use_gyro or when the
   /// samples do not cover the interval.
   bool gyroRotation(double from, double to, double* angle) const;
-  /// Drops the IMU samples before `stamp` (GyroBuffer::forgetBefore).
-  void forgetGyroBefore(double stamp) { gyro_.forgetBefore(stamp); }
-  /// Forgets the wheel odometry and the IMU samples (they belong to another timeline, e.g. time went
-  /// back).
-  void clearSensorHistory() {
-    odometry_.clear();
-    gyro_.clear();
+  /// Forgets the wheel odometry (its samples belong to another timeline: its clock went back).
+  void clearOdometry() { odometry_.clear(); }
+  /// The next prediction starts at the scan stamped `stamp`: the wheels' pose then (at `stamp` plus their
+  /// time offset, whatever offset up to `max_offset` is learned meanwhile) stays available.
+  void startNextPredictionAt(double stamp, double max_offset) {
+    odometry_.keepAround(stamp + odometry_time_offset_, std::abs(max_offset) + 0.5);
+    gyro_.forgetBefore(stamp);
   }
+  /// Forgets the IMU samples (another timeline).
+  void clearGyro() { gyro_.clear(); }
+  const OdometryBuffer& odometry() const { return odometry_; }
+
+  /// Seconds the wheels' stamps run late: their pose of a scan's instant t is read at t + offset.
+  void setOdometryTimeOffset(double offset) { odometry_time_offset_ = offset; }
+  double odometryTimeOffset() const { return odometry_time_offset_; }
 
   /// The motion of the base from `from` to `to`, with `noise`'s covariance. Sets *warning when the wheels
-  /// jumped (the velocity predicts instead) or the IMU turned implausibly fast (it is not used).
+  /// jumped (the velocity predicts instead) or the IMU turned implausibly fast (it is not used). Without
+  /// wheels over a step longer than kMaxVelocityAge the recent velocity says nothing: no motion is
+  /// predicted (source kNone), with the constant-velocity noise of kMaxVelocityAge.
   MotionPrediction predict(double from, double to, const MotionNoiseModel& noise, std::string* warning) const;
 
   /// A new estimate of the base pose. The velocity becomes the motion over the last kVelocityBaseline
@@ -105,6 +114,7 @@ class PoseExtrapolator {
   OdometryBuffer odometry_;
   bool use_gyro_;
   GyroBuffer gyro_;
+  double odometry_time_offset_ = 0.0;
   double gyro_bias_ = 0.0;
   double gyro_bias_variance_;
   std::deque<StampedPose> poses_;  // recent estimates, for the velocity

@@ -29,7 +29,12 @@ struct RelationStats {
   double rot_std_deg = 0.0;
   double trans_sq_mean = 0.0;    ///< m^2
   double rot_sq_mean_deg = 0.0;  ///< deg^2
+  double trans_median = 0.0;     ///< metres: what a typical relation sees (a few leaps move the mean)
+  double rot_median_deg = 0.0;
 };
+
+/// The median of `values` (the mean of the two middle ones for an even count; 0 for none).
+double median(std::vector<double> values);
 
 /// Evaluates the relations whose span |t2 - t1| is at most `max_span` seconds (<= 0: all) against
 /// `trajectory` (sorted by stamp). A relation's stamps must each match a trajectory stamp within

@@ -96,6 +96,9 @@ class LaserOdometry {
   /// base -> `frame` rotation, cached per frame (a static mount); tf is asked at most every
   /// kTfRetrySeconds while it lacks it.
   bool imuMount(const std::string& frame, geometry_msgs::Quaternion* rotation);
+  /// A throttled warning for an IMU (`imu`) or wheel sample the time policy dropped, one for a sample on a
+  /// new timeline.
+  void reportSample(bool imu, hglasm::SampleVerdict verdict);
   /// Logs once when the IMU stops covering the steps between scans and once when it is back.
   void reportImuState(const hglasm::PipelineUpdate& update);
   void processScan(const sensor_msgs::LaserScan& msg);
@@ -112,8 +115,9 @@ class LaserOdometry {
   void warnThrottled(const std::string& key, const std::string& text, double period);
 
   const LaserOdometryOptions options_;
-  const std::string name_;       // private namespace, prefixes log lines
-  const std::string imu_topic_;  // resolved `imu` (log lines name it)
+  const std::string name_;        // private namespace, prefixes log lines
+  const std::string imu_topic_;   // resolved `imu` (log lines name it)
+  const std::string odom_topic_;  // resolved `odom`
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
 
@@ -148,6 +152,9 @@ class LaserOdometry {
   std::uint64_t scans_processed_ = 0;
   std::uint64_t fallbacks_ = 0;
   std::uint64_t resets_ = 0;
+  hglasm::InputCounts input_counts_;  // the time policy's (pipeline_.inputCounts() after each scan)
+  double time_offset_ = 0.0;          // the wheels' time offset in use, and its estimate
+  double time_offset_estimate_ = 0.0;
   std::uint32_t last_reported_drops_ = 0;  // dropped_scans_ at the previous diagnostics report
   ros::WallTime last_scan_time_;
   bool waiting_for_tf_ = false;

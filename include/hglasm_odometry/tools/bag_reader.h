@@ -1,5 +1,6 @@
-// Reads laser scans, wheel odometry and the base -> laser mounting from a bag (rosbag C++ API),
-// sorted by header stamp, into core types. For the offline tools; needs no ROS master.
+// Reads laser scans, wheel odometry and the base -> laser mounting from a bag (rosbag C++ API) into core
+// types: sorted by header stamp for the evaluation, and the order a subscriber receives them in (the bag's)
+// for a replay. For the offline tools; needs no ROS master.
 #pragma once
 
 #include <string>
@@ -12,23 +13,36 @@
 namespace hglasm_odometry {
 
 struct BagScan {
-  double stamp = 0.0;  ///< header stamp, seconds
+  double stamp = 0.0;         ///< header stamp, seconds
+  double receive_time = 0.0;  ///< when the recorder received it (the bag's time), seconds
+  std::size_t sequence = 0;   ///< position among the scans and odometry read, in the bag's order
   hglasm::RangeScan ranges;
   std::string frame_id;
 };
 
 struct BagOdometry {
   double stamp = 0.0;
+  double receive_time = 0.0;
+  std::size_t sequence = 0;
   hglasm::Pose2D pose;  ///< base in the wheel-odometry frame
+};
+
+/// One message in the order a subscriber receives it: scans[index] or odometry[index].
+struct BagArrival {
+  bool scan = true;
+  std::size_t index = 0;
 };
 
 struct BagData {
   std::vector<BagScan> scans;         ///< sorted by stamp (bags may store a few out of order)
   std::vector<BagOdometry> odometry;  ///< sorted by stamp; empty if the topic is absent
-  bool has_laser_mount = false;       ///< base -> laser found on /tf_static (or /tf)
-  hglasm::Pose2D base_to_laser;       ///< planar part of base -> laser, after mirroring (see below)
-  bool laser_upside_down = false;     ///< laser z axis points down: scans must be mirrored
-  std::string base_frame;             ///< child frame of the odometry messages
+  /// Every scan and odometry message in the bag's order (by receive time, as rosbag plays them; at one
+  /// receive time, as stored).
+  std::vector<BagArrival> arrivals;
+  bool has_laser_mount = false;    ///< base -> laser found on /tf_static (or /tf)
+  hglasm::Pose2D base_to_laser;    ///< planar part of base -> laser, after mirroring (see below)
+  bool laser_upside_down = false;  ///< laser z axis points down: scans must be mirrored
+  std::string base_frame;          ///< child frame of the odometry messages
 };
 
 struct BagReadOptions {
@@ -40,6 +54,10 @@ struct BagReadOptions {
 
 /// False (with *error set) if the bag cannot be opened or holds no scans on the topic.
 bool readBag(const std::string& path, const BagReadOptions& options, BagData* data, std::string* error);
+
+/// Moves every odometry message `seconds` later, stamp and receive time (wheels published late by a motor
+/// controller), and re-orders the arrivals by receive time.
+void shiftOdometry(double seconds, BagData* data);
 
 /// Gives `pipeline` the bag's base -> laser mount, as the live node does from tf (nothing when the bag
 /// has none: the laser at the base origin).

@@ -1,0 +1,114 @@
+#include "hglasm_odometry/tools/bag_replay.h"
+
+#include <time.h>
+
+#include <algorithm>
+#include <deque>
+#include <limits>
+
+namespace hglasm_odometry {
+namespace {
+
+double threadCpuMs() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return now.tv_sec * 1e3 + now.tv_nsec * 1e-6;
+}
+
+/// The nodelet's worker over a bag: a FIFO of scans, each waiting for its inputs from when the worker
+/// turns to it (its arrival, or the end of the previous scan's wait).
+class Replay {
+ public:
+  Replay(const BagData& data, hglasm::OdometryPipeline* pipeline, const ReplayOptions& options,
+         const std::function<void(const ReplayedScan&)>& on_scan)
+      : data_(data), pipeline_(pipeline), options_(options), on_scan_(on_scan) {}
+
+  ReplayCounts run() {
+    const bool use_odometry = pipeline_->options().use_odometry;
+    for (const BagArrival& arrival : data_.arrivals) {
+      const double now =
+          arrival.scan ? data_.scans[arrival.index].receive_time : data_.odometry[arrival.index].receive_time;
+      timeOut(now);
+      if (arrival.scan) {
+        enqueue(&data_.scans[arrival.index], now);
+      } else if (use_odometry) {
+        const BagOdometry& sample = data_.odometry[arrival.index];
+        pipeline_->addOdometry(sample.stamp, sample.pose);
+      }
+      processReady(now);
+    }
+    timeOut(std::numeric_limits<double>::infinity());
+    return counts_;
+  }
+
+ private:
+  void enqueue(const BagScan* scan, double now) {
+    // The front scan is the worker's (out of the queue); behind it the queue drops its oldest.
+    if (waiting_.size() > std::max<std::size_t>(1, options_.queue_size)) {
+      waiting_.erase(waiting_.begin() + 1);
+      ++counts_.queue_drops;
+    }
+    waiting_.push_back(scan);
+    if (waiting_.size() == 1) wait_start_ = std::max(wait_start_, now);
+  }
+
+  /// The wall wait of the front scan, in bag seconds.
+  double waitLength() const {
+    if (!(options_.odometry_wait > 0.0)) return 0.0;
+    return (options_.odometry_wait + std::max(0.0, pipeline_->odometryTimeOffset())) * options_.rate;
+  }
+
+  /// Scans whose wait ended before `now` go on with what has arrived.
+  void timeOut(double now) {
+    while (!waiting_.empty()) {
+      const double deadline = wait_start_ + waitLength();
+      if (!(now > deadline)) break;
+      if (!pipeline_->inputsReadyFor(waiting_.front()->stamp, sweep(*waiting_.front()))) {
+        pipeline_->inputsWaitTimedOut(waiting_.front()->stamp, sweep(*waiting_.front()));
+        ++counts_.wait_timeouts;
+      }
+      processFront(deadline);
+    }
+  }
+
+  void processReady(double now) {
+    while (!waiting_.empty() &&
+           pipeline_->inputsReadyFor(waiting_.front()->stamp, sweep(*waiting_.front()))) {
+      processFront(now);
+    }
+  }
+
+  double sweep(const BagScan& scan) const {
+    return hglasm::scanSweepTime(scan.ranges.time_increment, scan.ranges.ranges.size(),
+                                 pipeline_->conversion());
+  }
+
+  void processFront(double now) {
+    ReplayedScan replayed;
+    replayed.scan = waiting_.front();
+    waiting_.pop_front();
+    const double start = threadCpuMs();
+    replayed.update = pipeline_->processScan(replayed.scan->stamp, replayed.scan->ranges);
+    replayed.cpu_ms = threadCpuMs() - start;
+    ++counts_.processed;
+    wait_start_ = now;  // the worker turns to the next scan
+    on_scan_(replayed);
+  }
+
+  const BagData& data_;
+  hglasm::OdometryPipeline* pipeline_;
+  const ReplayOptions& options_;
+  const std::function<void(const ReplayedScan&)>& on_scan_;
+  std::deque<const BagScan*> waiting_;
+  double wait_start_ = -std::numeric_limits<double>::infinity();
+  ReplayCounts counts_;
+};
+
+}  // namespace
+
+ReplayCounts replayBag(const BagData& data, hglasm::OdometryPipeline* pipeline, const ReplayOptions& options,
+                       const std::function<void(const ReplayedScan&)>& on_scan) {
+  return Replay(data, pipeline, options, on_scan).run();
+}
+
+}  // namespace hglasm_odometry
