@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs `evaluate` on the Freiburg relations benchmark logs (intel, fr079, aces) for every preset and prints
-# one table: relations metric (all and <= 10 s) of the laser odometry next to the raw wheel odometry,
+# Runs `evaluate` on the Freiburg relations benchmark logs (intel, fr079, aces, fr-clinic) for every preset
+# and prints one table: relations metric (all and <= 10 s, and the <= 10 s median translation) of the laser
+# odometry next to the raw wheel odometry, the wheels' time offset found (odometry/time_offset),
 # fallbacks, CPU per scan, the covariance calibration (mean squared Mahalanobis distance of the <= 10 s
 # relations; 3 is honest) and the leap ratio (largest <= 10 s error / (3 x the wheels' + 0.10 m); above 1 is
 # a leap). Logs, trajectories, traces and plots of each run go to the output directory.
@@ -12,7 +13,7 @@
 #   -d  the datasets folder (default: <package>/../shared/datasets)
 #   -o  where run logs, trajectories and plots go (default: /tmp/hglasm_evaluate_all)
 #   -p  presets (default: the top-level keys of config/presets.yaml, else "small medium large")
-#   -l  logs (default: "intel fr079 aces")
+#   -l  logs (default: "intel fr079 aces fr-clinic")
 # Example: scripts/evaluate_all.sh -e /work/build/devel/lib/hglasm_odometry/evaluate -- --config /tmp/my.yaml
 set -euo pipefail
 
@@ -21,7 +22,7 @@ evaluate="${EVALUATE:-}"
 datasets="$package_dir/../shared/datasets"
 out_dir="/tmp/hglasm_evaluate_all"
 presets=""
-logs="intel fr079 aces"
+logs="intel fr079 aces fr-clinic"
 
 while getopts "e:d:o:p:l:h" option; do
   case "$option" in
@@ -69,9 +70,9 @@ echo "runs:     $out_dir/<log>_<preset>.{log,txt,png}"
 [[ ${#extra_args[@]} -gt 0 ]] && echo "extra:    ${extra_args[*]}"
 echo
 
-header=$(printf "%-6s %-8s %6s %9s %21s | %-17s %-17s | %-17s %-17s | %5s %5s" \
-  log preset scans fallback "CPU ms med/p99/max" "<=10s laser m/deg" "<=10s wheel" "all laser m/deg" "all wheel" \
-  calib leap)
+header=$(printf "%-9s %-6s %5s %8s %19s | %-17s %-17s %-13s | %-17s %-17s | %5s %5s %6s" \
+  log preset scans fallback "CPU ms med/p99/max" "<=10s laser m/deg" "<=10s wheel" "median l/w m" \
+  "all laser m/deg" "all wheel" calib leap offset)
 echo "$header"
 printf '%*s\n' "${#header}" '' | tr ' ' '-'
 
@@ -88,17 +89,18 @@ for log in $logs; do
     run="$out_dir/${log}_${preset}"
     if ! "$evaluate" --bag "$bag" --relations "$relations" --preset "$preset" --quiet \
          --out "$run.txt" --trace "$run.trace" --plot "$run.png" "${extra_args[@]}" >"$run.log" 2>&1; then
-      printf "%-6s %-8s evaluate failed, see %s\n" "$log" "$preset" "$run.log"
+      printf "%-9s %-6s evaluate failed, see %s\n" "$log" "$preset" "$run.log"
       status=1
       continue
     fi
     summary="$(grep '^SUMMARY' "$run.log" | tail -n1)"
     field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$summary"; }
-    printf "%-6s %-8s %6s %8s%% %21s | %-17s %-17s | %-17s %-17s | %5s %5s\n" "$log" "$preset" "$(field scans)" \
-      "$(field fallback_pct)" "$(field cpu_median_ms)/$(field cpu_p99_ms)/$(field cpu_max_ms)" \
+    printf "%-9s %-6s %5s %7s%% %19s | %-17s %-17s %-13s | %-17s %-17s | %5s %5s %6s\n" "$log" "$preset" \
+      "$(field scans)" "$(field fallback_pct)" "$(field cpu_median_ms)/$(field cpu_p99_ms)/$(field cpu_max_ms)" \
       "$(field short_t) / $(field short_r)" "$(field wheel_short_t) / $(field wheel_short_r)" \
+      "$(field short_t_median)/$(field wheel_short_t_median)" \
       "$(field all_t) / $(field all_r)" "$(field wheel_all_t) / $(field wheel_all_r)" \
-      "$(printf %.2f "$(field calibration)")" "$(printf %.2f "$(field worst_leap)")"
+      "$(printf %.2f "$(field calibration)")" "$(printf %.2f "$(field worst_leap)")" "$(field time_offset)"
   done
 done
 exit $status

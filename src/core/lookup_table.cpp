@@ -186,6 +186,28 @@ std::uint8_t LookupTable::valueAt(const Eigen::Vector2d& point) const {
                      (lx & (kTileSize - 1))];
 }
 
+int LookupTable::beamsThroughSurfaces(const std::vector<Eigen::Vector2d>& points, const Pose2D& sensor,
+                                      double margin) const {
+  if (tiles_in_use_ == 0 || !sensor.isFinite()) return 0;
+  // Steps of one cell: a graded surface's band (value >= max / 2) is 2.4 sigma wide, a binary one a cell.
+  const double step = 1.0 / inv_cell_size_;
+  const auto surface = static_cast<std::uint8_t>(std::max<std::uint32_t>(1, maxCellValue() / 2));
+  const Eigen::Vector2d origin = sensor.translation();
+  int through = 0;
+  for (const Eigen::Vector2d& point : points) {
+    const double range = point.norm();
+    if (!std::isfinite(range) || range <= 2.0 * margin) continue;
+    const Eigen::Vector2d direction = (sensor * point - origin) / range;
+    for (double r = margin; r < range - margin; r += step) {
+      if (valueAt(origin + r * direction) >= surface) {
+        ++through;
+        break;
+      }
+    }
+  }
+  return through;
+}
+
 void FitnessPoints::assign(const std::vector<Eigen::Vector2d>& points) {
   x.clear();
   y.clear();

@@ -258,6 +258,18 @@ double OdometryTracker::scanLogLikelihood(const Scan& scan, const Pose2D& pose) 
   return weight * table.logLikelihood(points, pose, options_.likelihood_outlier);
 }
 
+double OdometryTracker::freeSpaceLogLikelihood(const Scan& scan, const Pose2D& pose) const {
+  // A beam crosses free space up to its end: something in front of a mapped wall (people) is allowed, a
+  // beam through the wall is not. Each such beam costs what an outlier point does.
+  const LookupTable& table = judgingTable();
+  if (table.empty() || scan.empty() || options_.likelihood_outlier <= 0.0) return 0.0;
+  const double independent = options_.matcher.mbicp.independent_points;
+  const double weight =
+      independent > 0.0 ? std::min(1.0, independent / std::max<double>(1.0, scan.size())) : 1.0;
+  const int through = table.beamsThroughSurfaces(scan.points, pose, 3.0 * table.options().sigma);
+  return weight * through * std::log(options_.likelihood_outlier);
+}
+
 double OdometryTracker::fitnessRatioAt(const Scan& scan, const Pose2D& pose) const {
   const LookupTable& table = judgingTable();
   if (table.empty() || scan.empty()) return 0.0;
@@ -347,9 +359,18 @@ void OdometryTracker::testLeap(const Scan& scan, const Hypotheses& h, std::vecto
                             matcher_.match(scan, h.prior.mean, population_out ? &wide_population : nullptr,
                                            &h.wide_search, &h.wide_prior),
                             h.prior);
-  const double stay_score = chosen->acceptable ? std::max(holds, wrong) : -HUGE_VAL;
+  // The competition adds the beams' free space, which the likelihood field leaves out: a scan occluded by
+  // people fits the map better turned onto another corridor, with beams through its walls.
+  const double stay_score = chosen->acceptable
+                                ? std::max(holds, wrong) + freeSpaceLogLikelihood(scan, chosen->match.pose)
+                                : -HUGE_VAL;
   double leap_holds = -HUGE_VAL, leap_wrong = -HUGE_VAL;
-  if (leap.acceptable) scoreHypotheses(scan, h, leap.match, &leap_holds, &leap_wrong);
+  if (leap.acceptable) {
+    scoreHypotheses(scan, h, leap.match, &leap_holds, &leap_wrong);
+    const double free_space = freeSpaceLogLikelihood(scan, leap.match.pose);
+    leap_holds += free_space;
+    leap_wrong += free_space;
+  }
   const bool leap_is_far = leap.mahalanobis_sq > options_.max_mahalanobis * options_.max_mahalanobis;
   Candidate* loser = &leap;
   if (std::max(leap_holds, leap_wrong) > stay_score) {

@@ -401,7 +401,7 @@ Run runTracker(const Arguments& args, const hglasm_odometry::LaserOdometryOption
     run.reanchored += update.reanchored;
     if (run.beam_times.empty()) run.beam_times = beamTimesOf(replayed.scan->ranges, result.scan);
     run.keyframes += update.new_keyframe;
-    run.resets += update.reset;
+    run.resets += update.reset && run.processed > 1;  // the first scan starts, it does not reset
     if (!update.warning.empty() && ++run.warnings <= 20 && !args.quiet) {
       std::printf("  warning at %.6f: %s\n", stamp, update.warning.c_str());
     }
@@ -437,8 +437,9 @@ Run runTracker(const Arguments& args, const hglasm_odometry::LaserOdometryOption
 void printRun(const Run& run, double data_seconds) {
   const std::size_t scans = run.processed;
   if (run.skipped) std::printf("\nskipped       %zu scans (--min-scan-interval)", run.skipped);
-  std::printf("\nscans         %zu processed, %d matched, %d keyframes, %d resets, %zu published\n", scans,
-              run.matched, run.keyframes, run.resets, run.trajectory.size());
+  std::printf(
+      "\nscans         %zu processed, %d matched, %d keyframes, %d resets after the start, %zu published\n",
+      scans, run.matched, run.keyframes, run.resets, run.trajectory.size());
   std::printf(
       "time policy   %zu stale scans and %llu stale odometry samples dropped, %llu clock jumps back; "
       "%zu scans dropped by the queue, %zu waits for inputs timed out (bag order, 1x playback)\n",

@@ -350,3 +350,37 @@ TEST(LookupTable, JoinedPointsGetNoFootprintAndAFewScatteredPointsNoHugeOne) {
   EXPECT_EQ(scattered.valueAt(Eigen::Vector2d(100.0, 0.5 + kCutoff + 0.05)), 0);
   EXPECT_LT(scattered.memoryBytes(), std::size_t(1) << 20);
 }
+
+namespace {
+
+/// A wall of reference points 2 m ahead of the origin, from y = -1 to 1, every centimetre.
+Points wallAtTwoMetres() {
+  Points wall;
+  for (int i = -100; i <= 100; ++i) wall.emplace_back(2.0, 0.01 * i);
+  return wall;
+}
+
+}  // namespace
+
+TEST(LookupTable, BeamsThroughSurfacesCountsOnlyBeamsThatPassTheWall) {
+  LookupTable table(gradedOptions());
+  table.build(wallAtTwoMetres());
+  const double margin = 3.0 * kSigma;
+  // Beyond the wall (through it), in front of it (an occluder), on it, and pointing away from it.
+  const Points beams = {{3.0, 0.0}, {4.0, 0.5}, {1.2, 0.0}, {2.0, 0.3}, {-3.0, 0.0}};
+  EXPECT_EQ(table.beamsThroughSurfaces(beams, hglasm::Pose2D(), margin), 2);
+  // Turned around, every beam points away from the wall but the last, which now passes it.
+  EXPECT_EQ(table.beamsThroughSurfaces(beams, hglasm::Pose2D(0.0, 0.0, M_PI), margin), 1);
+  // Moved beyond the wall: nothing lies between the sensor and the points ahead.
+  EXPECT_EQ(table.beamsThroughSurfaces({{3.0, 0.0}, {4.0, 0.5}}, hglasm::Pose2D(2.5, 0.0, 0.0), margin), 0);
+}
+
+TEST(LookupTable, BeamsThroughSurfacesIsZeroForAnEmptyTableOrPose) {
+  LookupTable empty(gradedOptions());
+  EXPECT_EQ(empty.beamsThroughSurfaces({{3.0, 0.0}}, hglasm::Pose2D(), 0.3), 0);
+  LookupTable table(gradedOptions());
+  table.build(wallAtTwoMetres());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(table.beamsThroughSurfaces({{3.0, 0.0}}, hglasm::Pose2D(nan, 0.0, 0.0), 0.3), 0);
+  EXPECT_EQ(table.beamsThroughSurfaces({{nan, 0.0}}, hglasm::Pose2D(), 0.3), 0);
+}

@@ -65,6 +65,12 @@ class LookupTable {
   /// outlier density, so points far from any reference point cost a bounded amount.
   double logLikelihood(const FitnessPoints& points, const Pose2D& pose, double outlier) const;
 
+  /// How many beams, from the sensor at `sensor` to each of `points` (sensor frame), pass a cell of at least
+  /// half the maximum value (a reference surface) farther than `margin` from both of their ends: beams
+  /// that see through the reference, which a pose that is right leaves few of.
+  int beamsThroughSurfaces(const std::vector<Eigen::Vector2d>& points, const Pose2D& sensor,
+                           double margin) const;
+
   /// Cell value at a point in the reference frame; 0 outside the table.
   std::uint8_t valueAt(const Eigen::Vector2d& point) const;
 

@@ -241,6 +241,9 @@ class OdometryTracker {
                          const Eigen::Matrix3d& prior_covariance) const;
   /// log p(scan | pose), of the scan's independent points (on the judging table as a likelihood field).
   double scanLogLikelihood(const Scan& scan, const Pose2D& pose) const;
+  /// log p(free space | pose): what the likelihood field leaves out, beams that pass through a surface of
+  /// the map before their end.
+  double freeSpaceLogLikelihood(const Scan& scan, const Pose2D& pose) const;
   /// The fitness ratio of `scan` at `pose` (local map's frame) on the judging table.
   double fitnessRatioAt(const Scan& scan, const Pose2D& pose) const;
   /// The fine graded table of the local map that scans are judged on: the matcher's own where it is one
