@@ -118,7 +118,7 @@ OdometryTracker::OdometryTracker(const TrackerOptions& options)
       matcher_(options.matcher),
       extrapolator_(options.use_odometry, options.odometry_max_extrapolation, options.max_odometry_speed,
                     options.max_odometry_turn_rate, options.use_imu, options.imu),
-      keyframes_(options.keyframe_distance, options.keyframe_angle, options.keyframe_min_fitness),
+      keyframes_(options.keyframe),
       noise_(options.motion),
       gyro_bias_(options.imu),
       time_offset_(options.odometry_time_offset),

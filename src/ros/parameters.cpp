@@ -320,9 +320,9 @@ void visitNodeOptions(Params& tree, LaserOdometryOptions* options) {
 template <typename Params>
 void visitTrackerOptions(Params& tree, hglasm::TrackerOptions* options) {
   hglasm::TrackerOptions& tracker = *options;
-  tree.positiveNumber("keyframe/distance", &tracker.keyframe_distance);
-  tree.number("keyframe/angle", &tracker.keyframe_angle, 0.0, M_PI, true);
-  tree.fraction("keyframe/min_fitness", &tracker.keyframe_min_fitness);
+  tree.positiveNumber("keyframe/distance", &tracker.keyframe.distance);
+  tree.number("keyframe/angle", &tracker.keyframe.angle, 0.0, M_PI, true);
+  tree.fraction("keyframe/min_fitness", &tracker.keyframe.min_fitness);
   tree.fraction("min_fitness", &tracker.min_fitness);
   tree.positiveInteger("min_points", &tracker.min_points);
   tree.number("fallback_covariance_scale", &tracker.fallback_covariance_scale, 1.0, 1e12);
@@ -636,8 +636,8 @@ std::string summarize(const LaserOdometryOptions& options) {
   out << "preset " << options.preset << ", algorithm " << hglasm::toString(matcher.algorithm) << ", box +-"
       << genetic.box.half_x << " m x +-" << genetic.box.half_y << " m x +-" << genetic.box.half_theta
       << " rad, GA " << genetic.population << "x" << genetic.generations << "x" << genetic.runs << ", cell "
-      << matcher.table.cell_size << " m, keyframe " << options.tracker.keyframe_distance << " m / "
-      << options.tracker.keyframe_angle << " rad, " << options.odom_frame << " -> " << options.base_frame
+      << matcher.table.cell_size << " m, keyframe " << options.tracker.keyframe.distance << " m / "
+      << options.tracker.keyframe.angle << " rad, " << options.odom_frame << " -> " << options.base_frame
       << (options.publish_tf ? " (tf)" : " (no tf)")
       << (options.tracker.use_odometry ? ", wheel odometry in" : ", no wheel odometry")
       << (options.tracker.use_imu

@@ -19,7 +19,11 @@ constexpr double kMinFitness = 0.6;  // fitness ratio
 
 /// A policy whose newest keyframe was taken with the base at `keyframe` by a 360-beam scanner.
 KeyframePolicy policyAt(const Pose2D& keyframe) {
-  KeyframePolicy policy(kDistance, kAngle, kMinFitness);
+  hglasm::KeyframeOptions options;
+  options.distance = kDistance;
+  options.angle = kAngle;
+  options.min_fitness = kMinFitness;
+  KeyframePolicy policy(options);
   policy.keyframeAdded(keyframe);
   return policy;
 }

@@ -310,8 +310,8 @@ TEST(OdometryTracker, DeskewUndoesTheShearOfASweepTakenWhileMoving) {
 
 TEST(OdometryTracker, KeyframesFollowKeyframeDistance) {
   TrackerOptions options = withoutOdometry();
-  options.keyframe_distance = 0.30;
-  options.keyframe_angle = 10.0;
+  options.keyframe.distance = 0.30;
+  options.keyframe.angle = 10.0;
   SimulatedRobot robot(options, straightPath(0.4));  // 0.04 m per scan
   int keyframes = 0;
   for (int i = 1; i <= 40; ++i) {  // 1.6 m: a new keyframe past every 0.30 m, i.e. every 8 scans
@@ -329,8 +329,8 @@ TEST(OdometryTracker, KeyframesFollowKeyframeDistance) {
 
 TEST(OdometryTracker, KeyframesFollowKeyframeAngle) {
   TrackerOptions options = withoutOdometry();
-  options.keyframe_distance = 100.0;
-  options.keyframe_angle = 0.20;
+  options.keyframe.distance = 100.0;
+  options.keyframe.angle = 0.20;
   SimulatedRobot robot(options, spinPath(0.3));  // 0.03 rad per scan
   int keyframes = 0;
   const int first_keyframe = robot.step(0.0).keyframe_id;

@@ -493,7 +493,7 @@ TEST(Robustness, ScansAlternatingBetween180And181BeamsAndFourStartAnglesNeedNoKe
   // As fr-clinic's interleaving scanner: 180 or 181 beams of 1 degree, the first at one of four angles a
   // quarter degree apart. Keyframes come with the motion only (0.05 m per scan: one per 0.3 m).
   TrackerOptions options;
-  options.keyframe_distance = 0.3;
+  options.keyframe.distance = 0.3;
   const auto path = [](double t) { return hglasm_test::rawPose(0.5 * t, 0.0, 0.0); };
   Robot robot(options, path);
   robot.enableOdometry();

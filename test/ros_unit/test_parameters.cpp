@@ -93,7 +93,7 @@ TEST(Parameters, PresetsYamlThenTopLevelOverridesWin) {
   ASSERT_TRUE(loadOptions(root, &options, &error)) << error;
   EXPECT_EQ(options.tracker.matcher.genetic.population, 33);          // from ~presets/small
   EXPECT_DOUBLE_EQ(options.tracker.matcher.genetic.box.half_x, 0.5);  // top level beats the preset
-  EXPECT_DOUBLE_EQ(options.tracker.keyframe_distance, 0.7);
+  EXPECT_DOUBLE_EQ(options.tracker.keyframe.distance, 0.7);
   EXPECT_EQ(options.odom_frame, "laser_odom");  // leading slash stripped
   EXPECT_FALSE(options.tracker.use_odometry);
 }

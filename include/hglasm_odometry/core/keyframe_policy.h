@@ -8,11 +8,16 @@
 
 namespace hglasm {
 
+struct KeyframeOptions {
+  double distance = 0.30;    ///< metres moved since the keyframe that make a new keyframe
+  double angle = 0.20;       ///< radians turned since the keyframe that make a new keyframe
+  double min_fitness = 0.0;  ///< a published pose below this fitness ratio makes the scan a keyframe
+};
+
 /// Not thread-safe per instance.
 class KeyframePolicy {
  public:
-  /// `distance` (m) and `angle` (rad) moved since the keyframe, a fitness ratio below `min_fitness`.
-  KeyframePolicy(double distance, double angle, double min_fitness);
+  explicit KeyframePolicy(const KeyframeOptions& options);
 
   /// Whether the scan, its base now estimated at `pose`, becomes a keyframe: moved or turned too far since
   /// the keyframe, its match failed (`match_failed`), or, `matched`, its `fitness_ratio` at the estimated
@@ -23,9 +28,7 @@ class KeyframePolicy {
   void keyframeAdded(const Pose2D& pose) { pose_ = pose; }
 
  private:
-  double distance_;
-  double angle_;
-  double min_fitness_;
+  KeyframeOptions options_;
   Pose2D pose_;  // base pose of the newest keyframe
 };
 

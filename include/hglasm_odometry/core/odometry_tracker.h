@@ -24,11 +24,9 @@ struct TrackerOptions {
   ScanConversionOptions conversion;  ///< applied by callers that convert RangeScans (ROS layer, tools)
   LocalMapOptions local_map;
   MotionNoiseOptions motion;
-  double keyframe_distance = 0.30;    ///< metres moved since the keyframe that make a new keyframe
-  double keyframe_angle = 0.20;       ///< radians turned since the keyframe that make a new keyframe
-  double keyframe_min_fitness = 0.0;  ///< a published pose below this fitness ratio makes the scan a keyframe
-  double min_fitness = 0.15;          ///< a match whose pose is below this fitness ratio has failed
-  int min_points = 20;                ///< scans with fewer valid points are not matched
+  KeyframeOptions keyframe;
+  double min_fitness = 0.15;                 ///< a match whose pose is below this fitness ratio has failed
+  int min_points = 20;                       ///< scans with fewer valid points are not matched
   double fallback_covariance_scale = 100.0;  ///< covariance inflation of a step whose match failed
   double odometry_max_extrapolation = 0.25;  ///< seconds; beyond, wheel odometry counts as stale
   /// The wheels' stamps may run late against the scans': learned from the matches, or fixed.
@@ -104,7 +102,7 @@ struct TrackerUpdate {
   MatchResult match;  ///< raw matcher output (laser frame, local map's frame)
   /// How well the scan fits the local map at the published pose: the cells its points hit on the fine
   /// graded table / (255 * points), 1 = every point on the map; whatever the algorithm, the ratio
-  /// min_fitness, keyframe_min_fitness and the doubt about the prediction judge. 0 without a map or a usable
+  /// min_fitness, keyframe.min_fitness and the doubt about the prediction judge. 0 without a map or a usable
   /// scan.
   double fitness_ratio = 0.0;
   Pose2D guess;  ///< predicted pose of the base (odometry frame) before matching
