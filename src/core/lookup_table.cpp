@@ -38,12 +38,21 @@ void LookupTable::buildKernel() {
       kernel_[(dy + kernel_radius_) * side + dx + kernel_radius_] = value;
     }
   }
+  kernel_spans_.assign(static_cast<std::size_t>(side), {0, 0});
+  for (int row = 0; row < side; ++row) {
+    const std::uint8_t* values = &kernel_[static_cast<std::size_t>(row) * side];
+    int first = 0, last = side;
+    while (first < side && values[first] == 0) ++first;
+    while (last > first && values[last - 1] == 0) --last;
+    kernel_spans_[row] = {first, last};
+  }
 }
 
 std::uint32_t LookupTable::maxCellValue() const { return options_.kind == TableKind::kGraded ? 255u : 1u; }
 
 std::size_t LookupTable::memoryBytes() const {
-  return tile_index_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() + kernel_.capacity();
+  return tile_index_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() + stamped_.capacity() +
+         kernel_.capacity();
 }
 
 void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
@@ -151,24 +160,39 @@ void LookupTable::build(const ReferencePoints& reference_set) {
   }
   tile_cells_.assign(tiles_in_use_ * kTileCells, 0);
 
-  // Stamp the kernel around each point, keeping the maximum (likelihood of the nearest point).
+  // Stamp the kernel around each point, keeping the maximum (likelihood of the nearest point). A stamp
+  // depends on the centre's cell only: overlapping keyframes and close samples put many in one cell, which
+  // is stamped once.
+  stamped_.assign(tiles_in_use_ * kTileCells, 0);
   const long side = 2 * r + 1;
   for (const auto& cell : cells) {
-    const long lx0 = cell.first - r - origin_cell_x_;
-    const long ly0 = cell.second - r - origin_cell_y_;
+    const long cx = cell.first - origin_cell_x_, cy = cell.second - origin_cell_y_;
+    std::uint8_t& centre =
+        stamped_[static_cast<std::size_t>(tile_index_[(cy >> kTileShift) * tiles_x_ + (cx >> kTileShift)]) *
+                     kTileCells +
+                 ((cy & (kTileSize - 1)) << kTileShift) + (cx & (kTileSize - 1))];
+    if (centre) continue;
+    centre = 1;
+    const long lx0 = cx - r;
+    const long ly0 = cy - r;
     for (long ky = 0; ky < side; ++ky) {
       const long ly = ly0 + ky;
       const std::int32_t* index_row = &tile_index_[(ly >> kTileShift) * tiles_x_];
       const std::uint8_t* kernel_row = &kernel_[ky * side];
       const long cell_row = (ly & (kTileSize - 1)) << kTileShift;
-      for (long kx = 0; kx < side; ++kx) {
-        const std::uint8_t value = kernel_row[kx];
-        if (value == 0) continue;
+      // The row's non-zero span, in runs that stay within one tile: contiguous bytes the compiler
+      // vectorises.
+      const long end = kernel_spans_[ky].second;
+      for (long kx = kernel_spans_[ky].first; kx < end;) {
         const long lx = lx0 + kx;
-        std::uint8_t& target =
-            tile_cells_[static_cast<std::size_t>(index_row[lx >> kTileShift]) * kTileCells + cell_row +
-                        (lx & (kTileSize - 1))];
-        if (value > target) target = value;
+        const long in_tile = lx & (kTileSize - 1);
+        const long run = std::min(end - kx, kTileSize - in_tile);
+        std::uint8_t* target =
+            &tile_cells_[static_cast<std::size_t>(index_row[lx >> kTileShift]) * kTileCells + cell_row +
+                         in_tile];
+        const std::uint8_t* value = kernel_row + kx;
+        for (long i = 0; i < run; ++i) target[i] = std::max(target[i], value[i]);
+        kx += run;
       }
     }
   }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "hglasm_odometry/core/pose2d.h"
@@ -156,8 +157,10 @@ class LookupTable {
   std::vector<std::int32_t> tile_index_;  // tiles_x_ * tiles_y_, -1 = no tile
   std::vector<std::uint8_t> tile_cells_;  // tiles_in_use_ * kTileCells
   std::size_t tiles_in_use_ = 0;
-  std::vector<Eigen::Vector2d> samples_;  // scratch: stamp centres
-  std::vector<std::uint8_t> kernel_;      // (2r+1)^2 stamp, r = ceil(cutoff / cell_size)
+  std::vector<Eigen::Vector2d> samples_;             // scratch: stamp centres
+  std::vector<std::uint8_t> stamped_;                // scratch: 1 where a stamp is centred (as tile_cells_)
+  std::vector<std::uint8_t> kernel_;                 // (2r+1)^2 stamp, r = ceil(cutoff / cell_size)
+  std::vector<std::pair<long, long>> kernel_spans_;  // per kernel row: [first, last) non-zero columns
   int kernel_radius_ = 0;
 };
 
