@@ -40,8 +40,13 @@ Eigen::Matrix3d MotionNoiseModel::odometryCovariance(const Pose2D& increment, do
 
 Eigen::Matrix3d MotionNoiseModel::constantVelocityCovariance(double dt) const {
   const double elapsed = std::isfinite(dt) ? std::max(0.0, dt) : 0.0;
-  const double var_xy = std::max(square(options_.constant_velocity_xy * elapsed), 1e-12);
-  const double var_theta = std::max(square(options_.constant_velocity_theta * elapsed), 1e-12);
+  const double step_sq = elapsed * elapsed;
+  const double var_xy = std::max(square(options_.constant_velocity_velocity_xy * elapsed) +
+                                     square(0.5 * options_.constant_velocity_xy * step_sq),
+                                 1e-12);
+  const double var_theta = std::max(square(options_.constant_velocity_velocity_theta * elapsed) +
+                                        square(0.5 * options_.constant_velocity_theta * step_sq),
+                                    1e-12);
   return Eigen::Vector3d(var_xy, var_xy, var_theta).asDiagonal();
 }
 

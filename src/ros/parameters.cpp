@@ -366,6 +366,8 @@ void visitPredictionOptions(Params& tree, LaserOdometryOptions* options) {
   tree.positiveNumber("odometry/noise/max_scale", &motion.max_scale);
   tree.positiveNumber("constant_velocity/xy", &motion.constant_velocity_xy);
   tree.positiveNumber("constant_velocity/theta", &motion.constant_velocity_theta);
+  tree.nonNegativeNumber("constant_velocity/velocity_xy", &motion.constant_velocity_velocity_xy);
+  tree.nonNegativeNumber("constant_velocity/velocity_theta", &motion.constant_velocity_velocity_theta);
   tree.positiveNumber("odometry/max_speed", &tracker.max_odometry_speed);
   tree.positiveNumber("odometry/max_turn_rate", &tracker.max_odometry_turn_rate);
   tree.number("odometry/wait", &options->odometry_wait, 0.0, 10.0);

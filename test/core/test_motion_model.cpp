@@ -44,13 +44,23 @@ TEST(MotionNoiseModel, StandingStillIsNeverExactlyCertain) {
   EXPECT_TRUE(MotionNoiseModel().odometryCovariance(Pose2D(), std::nan("")).allFinite());
 }
 
-TEST(MotionNoiseModel, ConstantVelocityGuessIsOffByTheVelocityChangeTimesTheStep) {
+TEST(MotionNoiseModel, ConstantVelocityGuessIsOffByTheVelocityErrorAndTheAcceleration) {
   MotionNoiseOptions options;
   options.constant_velocity_xy = 1.0;
   options.constant_velocity_theta = 2.0;
-  const Eigen::Matrix3d c = MotionNoiseModel(options).constantVelocityCovariance(0.1);
-  EXPECT_NEAR(std::sqrt(c(0, 0)), 0.1, 1e-12);
-  EXPECT_NEAR(std::sqrt(c(2, 2)), 0.2, 1e-12);
+  options.constant_velocity_velocity_xy = 0.2;
+  options.constant_velocity_velocity_theta = 0.3;
+  const MotionNoiseModel model(options);
+  // 0.1 s: mostly the velocity's error (0.02 m, 0.03 rad), a little acceleration (0.005 m, 0.01 rad).
+  Eigen::Matrix3d c = model.constantVelocityCovariance(0.1);
+  EXPECT_NEAR(std::sqrt(c(0, 0)), std::hypot(0.02, 0.005), 1e-12);
+  EXPECT_NEAR(std::sqrt(c(1, 1)), std::hypot(0.02, 0.005), 1e-12);
+  EXPECT_NEAR(std::sqrt(c(2, 2)), std::hypot(0.03, 0.01), 1e-12);
+  // 2 s: mostly the acceleration (2 m, 4 rad beside 0.4 m, 0.6 rad).
+  c = model.constantVelocityCovariance(2.0);
+  EXPECT_NEAR(std::sqrt(c(0, 0)), std::hypot(0.4, 2.0), 1e-12);
+  EXPECT_NEAR(std::sqrt(c(2, 2)), std::hypot(0.6, 4.0), 1e-12);
+  EXPECT_GT(model.constantVelocityCovariance(0.0).determinant(), 0.0) << "stays invertible";
 }
 
 /// Feeds `count` increments whose true noise is `true_scale` times the nominal model; returns the model.

@@ -18,10 +18,12 @@ struct MotionNoiseOptions {
   double theta_per_metre = 0.02;    ///< rad of heading noise after 1 m travelled
   double theta_per_radian = 0.05;   ///< rad after 1 rad turned
   double theta_per_second = 0.002;  ///< rad after 1 s
-  /// Without wheel odometry the motion is extrapolated at constant velocity; the velocity may change by
-  /// this much per second (standard deviation), so the guess is off by about this times the time step.
-  double constant_velocity_xy = 1.0;     ///< m/s per s
-  double constant_velocity_theta = 1.5;  ///< rad/s per s
+  /// Without wheel odometry the motion is extrapolated at the velocity of the last scans' poses. The guess
+  /// is off by the velocity's own error times the step plus half the acceleration times its square.
+  double constant_velocity_xy = 1.0;              ///< m/s per s: acceleration (standard deviation)
+  double constant_velocity_theta = 1.5;           ///< rad/s per s: angular acceleration
+  double constant_velocity_velocity_xy = 0.2;     ///< m/s: error of the velocity measured from the scans
+  double constant_velocity_velocity_theta = 0.3;  ///< rad/s: error of the turn rate measured from the scans
   /// Learn the wheels' noise online: scale the translation and the heading variances above by what the
   /// scan matches show about the wheel increments (method of moments, exponential forgetting), so that one
   /// configuration serves robots with good and with bad wheels.
