@@ -55,6 +55,23 @@ double OdometryBuffer::largestGap(double from, double to) const {
   return largest;
 }
 
+double OdometryBuffer::largestTurnRate(double from, double to) const {
+  if (samples_.empty() || !(samples_.front().stamp <= from) || !(samples_.back().stamp >= to)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  auto it = std::upper_bound(samples_.begin(), samples_.end(), from,
+                             [](double t, const Sample& sample) { return t < sample.stamp; });
+  if (it != samples_.begin()) --it;
+  double largest = 0.0;
+  for (auto next = it + 1; next != samples_.end() && it->stamp < to; ++it, ++next) {
+    const double turn = std::abs(normalizeAngle(next->pose.theta - it->pose.theta));
+    const double dt = next->stamp - it->stamp;
+    largest = std::max(largest,
+                       dt > 0.0 ? turn / dt : (turn > 0.0 ? std::numeric_limits<double>::infinity() : 0.0));
+  }
+  return largest;
+}
+
 double OdometryBuffer::newestStamp() const { return samples_.empty() ? 0.0 : samples_.back().stamp; }
 
 bool OdometryBuffer::poseAt(double stamp, double max_extrapolation, Pose2D* pose) const {

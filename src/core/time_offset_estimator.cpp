@@ -51,6 +51,9 @@ void TimeOffsetEstimator::score(const Window& window, const OdometryBuffer& whee
   // interpolating across their gaps: no measure of their timing.
   const double reach = options_.max_offset + 0.5 * kStep;
   if (wheels.largestGap(window.from - reach, window.to + reach) > kMaxSampleGap) return;
+  // A jump of the wheels' frame (a driver restart, a glitch) inside the window would be "explained" by
+  // whichever shift moves it out: such windows say nothing about the timing.
+  if (wheels.largestTurnRate(window.from - reach, window.to + reach) > kMaxWheelTurnRate) return;
   // Every candidate must see the window, or their costs would not compare.
   std::vector<double> turns(heading_.size());
   for (std::size_t k = 0; k < turns.size(); ++k) {

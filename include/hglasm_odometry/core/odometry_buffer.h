@@ -32,6 +32,10 @@ class OdometryBuffer {
   /// included): how finely the buffer knows the motion there. Infinity where it does not cover the span.
   double largestGap(double from, double to) const;
 
+  /// The fastest turn between consecutive samples over [from, to] (rad/s; the samples around either end
+  /// included; infinity for a turn between two samples of one stamp or where it does not cover the span).
+  double largestTurnRate(double from, double to) const;
+
   double newestStamp() const;
   bool empty() const { return samples_.empty(); }
   std::size_t size() const { return samples_.size(); }

@@ -61,6 +61,8 @@ class TimeOffsetEstimator {
   /// Seconds: windows where the wheels' samples lie farther apart than this (at any candidate) are not
   /// scored; reading them between their samples would measure the interpolation, not their timing.
   static constexpr double kMaxSampleGap = 0.25;
+  /// rad/s: wheels turning faster between two samples jumped (a base does not spin a turn per second).
+  static constexpr double kMaxWheelTurnRate = 2.0 * 3.14159265358979323846;
 
  private:
   struct Window {
