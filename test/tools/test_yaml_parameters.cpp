@@ -1,5 +1,6 @@
 // loadYamlParameters gives exactly what rosparam gives (the same types, the same bits) on the shipped
-// configuration and on a file of every kind of scalar, and a clear error on what rosparam cannot load.
+// configuration and on a file of every kind of scalar it reads, and an error naming the key on what it
+// refuses (what rosparam would read otherwise or the parameter server cannot hold).
 #include "hglasm_odometry/tools/yaml_parameters.h"
 
 #include <gtest/gtest.h>
@@ -148,18 +149,36 @@ TEST(YamlParameters, InvalidYamlIsAnErrorNamingFileLineAndColumn) {
   EXPECT_NE(error.find("end of sequence flow not found"), std::string::npos) << error;
 }
 
+TEST(YamlParameters, ErrorsNameTheFileTheLineAndTheKey) {
+  EXPECT_NE(loadError("hglasm_null.yaml", "a: 1\nb: ~\n").find("hglasm_null.yaml:2: b: a null value"),
+            std::string::npos);
+  const std::string nested = loadError("hglasm_nested.yaml", "outer:\n  list: [1, 2]\n  inner: 1e-3\n");
+  EXPECT_NE(nested.find("hglasm_nested.yaml:3: outer/inner: '1e-3' is not read here as rosparam reads it"),
+            std::string::npos)
+      << nested;
+  const std::string listed = loadError("hglasm_listed.yaml", "outer:\n  list: [1, ~]\n");
+  EXPECT_NE(listed.find(":2: outer/list[1]: a null value"), std::string::npos) << listed;
+}
+
 TEST(YamlParameters, WhatTheParameterServerCannotHoldIsAnError) {
-  EXPECT_NE(loadError("hglasm_null.yaml", "a: 1\nb: ~\n").find("hglasm_null.yaml:2: a null value"),
-            std::string::npos);
-  EXPECT_NE(loadError("hglasm_key.yaml", "1: one\n").find("key '1' is not a string"), std::string::npos);
-  EXPECT_NE(loadError("hglasm_big.yaml", "a: 4294967296\n").find("not a 32-bit integer"), std::string::npos);
-  EXPECT_NE(loadError("hglasm_date.yaml", "a: 2024-01-02\n").find("timestamp"), std::string::npos);
-  EXPECT_NE(loadError("hglasm_angle.yaml", "a: !radians sqrt(2)\n").find("invalid radian expression"),
-            std::string::npos);
+  EXPECT_NE(loadError("hglasm_key.yaml", "1: one\n").find("1: a key must be a string"), std::string::npos);
+  EXPECT_NE(loadError("hglasm_big.yaml", "a: 4294967296\n").find("not a 32-bit int"), std::string::npos);
   EXPECT_NE(loadError("hglasm_list.yaml", "- 1\n- 2\n").find("does not hold a dictionary"),
             std::string::npos);
   EXPECT_NE(loadError("hglasm_tag.yaml", "a: !custom 1\n").find("unsupported tag '!custom'"),
             std::string::npos);
+  EXPECT_NE(loadError("hglasm_str.yaml", "a: !!str 12\n").find("unsupported tag"), std::string::npos);
+}
+
+TEST(YamlParameters, ScalarsRosparamWouldReadOtherwiseAreErrors) {
+  // rosparam: a string, 8, 31, 5, 90, 1000, a string, a date, a merge, an expression, an expression.
+  for (const char* text :
+       {"1e-3", "010", "0x1F", "0b101", "1:30", "1_000", "-.5", "2024-01-02", "deg(pi)", "rad(pi/2)", "08"}) {
+    const std::string error = loadError("hglasm_refused.yaml", std::string("a: ") + text + "\n");
+    EXPECT_NE(error.find(std::string("a: '") + text + "' is not read here"), std::string::npos) << error;
+  }
+  const std::string merge = loadError("hglasm_merge.yaml", "base: &b {x: 1}\nm:\n  <<: *b\n");
+  EXPECT_NE(merge.find(":3: m/<<: '<<' is not read here"), std::string::npos) << merge;
 }
 
 TEST(YamlParameters, MissingFileIsAnError) {
