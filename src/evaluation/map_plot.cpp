@@ -24,12 +24,6 @@ constexpr int kTitleHeight = 30;
 constexpr double kMinGridPixels = 4.0;
 constexpr double kMinLabelPixels = 60.0;
 
-std::string shellQuote(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
 /// The smallest number 1, 2 or 5 times a power of ten that is a multiple of `unit` and at least `least`
 /// (the least multiple of `unit` if no such number is near).
 double niceMultiple(double unit, double least) {
@@ -256,12 +250,12 @@ bool writeMapPlot(const std::string& png, const std::vector<std::vector<Eigen::V
                   const std::vector<MapView>& views, const MapPlotOptions& options, std::string* error) {
   std::string script;
   if (!writeMapFiles(png, scans, views, options, &script, error)) return false;
-  const int status = std::system(("gnuplot " + shellQuote(script)).c_str());
+  const bool plotted = runGnuplot(script);
   if (!options.keep_files) {
     std::remove(script.c_str());
     std::remove((png + ".map.dat").c_str());
   }
-  if (status != 0) {
+  if (!plotted) {
     if (error) *error = "gnuplot failed on " + script;
     return false;
   }

@@ -8,6 +8,8 @@
 #include <iterator>
 #include <sstream>
 
+#include "hglasm_odometry/evaluation/statistics.h"
+
 namespace hglasm {
 
 namespace {
@@ -66,14 +68,6 @@ bool readRelations(const std::string& path, std::vector<Relation>* relations, st
     relations->push_back(relation);
   }
   return true;
-}
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const std::size_t half = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + half, values.end());
-  if (values.size() % 2) return values[half];
-  return 0.5 * (values[half] + *std::max_element(values.begin(), values.begin() + half));
 }
 
 RelationStats evaluateRelations(const std::vector<Relation>& relations,
@@ -183,8 +177,7 @@ CalibrationStats evaluateCalibration(const std::vector<Relation>& relations,
   }
   stats.mean_sq_mahalanobis = sum / distances.size();
   stats.fraction_within_3dof_95 = static_cast<double>(within) / distances.size();
-  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-  stats.median_sq_mahalanobis = distances[distances.size() / 2];
+  stats.median_sq_mahalanobis = kthSmallest(distances, distances.size() / 2);  // the upper median
   return stats;
 }
 

@@ -8,6 +8,8 @@
 #include <memory>
 #include <sstream>
 
+#include "hglasm_odometry/evaluation/statistics.h"
+
 namespace hglasm {
 namespace {
 
@@ -195,18 +197,6 @@ struct Tally {
   double mean(double sum) const { return trials > 0 ? sum / trials : 0.0; }
   double ratio() const { return trials > 0 ? static_cast<double>(successes) / trials : 0.0; }
 };
-
-// Median (the mean of the middle two for an even count); 0 when empty.
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const std::size_t middle = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle), values.end());
-  const double upper = values[middle];
-  if (values.size() % 2 == 1) return upper;
-  const double lower =
-      *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle));
-  return 0.5 * (lower + upper);
-}
 
 Tally runTrials(ScanMatcher* matcher, const std::vector<TrialPair>& pairs,
                 const SuccessThresholds& thresholds, bool prealign_only) {

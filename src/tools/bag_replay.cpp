@@ -1,19 +1,13 @@
 #include "hglasm_odometry/tools/bag_replay.h"
 
-#include <time.h>
-
 #include <algorithm>
 #include <deque>
 #include <limits>
 
+#include "hglasm_odometry/tools/cpu_time.h"
+
 namespace hglasm_odometry {
 namespace {
-
-double threadCpuMs() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return now.tv_sec * 1e3 + now.tv_nsec * 1e-6;
-}
 
 /// The nodelet's worker over a bag: a FIFO of scans, each waiting for its inputs from when the worker
 /// turns to it (its arrival, or the end of the previous scan's wait).

@@ -1,4 +1,4 @@
-// Text for the gnuplot scripts the evaluation writes.
+// Writing and running the gnuplot scripts of the evaluation and the tools.
 #pragma once
 
 #include <string>
@@ -6,13 +6,12 @@
 namespace hglasm {
 
 /// `text` as a gnuplot single-quoted string (a quote inside is doubled).
-inline std::string gnuplotQuote(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) {
-    quoted += c;
-    if (c == '\'') quoted += '\'';
-  }
-  return quoted + "'";
-}
+std::string gnuplotQuote(const std::string& text);
+
+/// `text` as one POSIX shell word in single quotes.
+std::string shellQuote(const std::string& text);
+
+/// Runs `gnuplot SCRIPT`; true if it exited with 0.
+bool runGnuplot(const std::string& script);
 
 }  // namespace hglasm

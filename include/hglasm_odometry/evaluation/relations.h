@@ -33,9 +33,6 @@ struct RelationStats {
   double rot_median_deg = 0.0;
 };
 
-/// The median of `values` (the mean of the two middle ones for an even count; 0 for none).
-double median(std::vector<double> values);
-
 /// Evaluates the relations whose span |t2 - t1| is at most `max_span` seconds (<= 0: all) against
 /// `trajectory` (sorted by stamp). A relation's stamps must each match a trajectory stamp within
 /// `stamp_tolerance` seconds, else it counts as missing.

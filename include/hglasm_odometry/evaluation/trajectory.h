@@ -1,0 +1,43 @@
+// Trajectories in the evaluation: wheel odometry at the scan stamps, moved to another frame or start,
+// written as text (the tools' --out and --trace files) and plotted with gnuplot.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "hglasm_odometry/core/odometry_buffer.h"
+#include "hglasm_odometry/core/odometry_tracker.h"
+#include "hglasm_odometry/core/pose2d.h"
+
+namespace hglasm {
+
+/// The poses of `odometry` at each of `stamps` plus `shift`, stamped with the stamp, where it has them
+/// (interpolated, or at most `max_extrapolation` s beyond its samples).
+std::vector<StampedPose> trajectoryAt(const OdometryBuffer& odometry, const std::vector<double>& stamps,
+                                      double max_extrapolation, double shift = 0.0);
+
+/// Each pose followed by `offset` (pose * offset): the laser's trajectory from the base's and the mount.
+std::vector<StampedPose> followedBy(std::vector<StampedPose> trajectory, const Pose2D& offset);
+
+/// `trajectory` moved rigidly so that its first pose is `start`.
+std::vector<StampedPose> startedAt(std::vector<StampedPose> trajectory, const Pose2D& start);
+
+/// 'stamp x y theta' per pose; with `increment_covariances` (one per pose) also the covariance of the
+/// motion since the previous pose, in that pose's frame: 'xx xy xtheta yy ytheta thetatheta'.
+bool writeTrajectory(const std::string& path, const std::vector<StampedPose>& trajectory,
+                     const std::vector<Eigen::Matrix3d>* increment_covariances = nullptr);
+
+/// One line per scan: what the tracker decided and why (the first line names the columns).
+bool writeTrackerTrace(const std::string& path, const std::vector<TrackerUpdate>& updates);
+
+/// The gnuplot script plotting the trajectory files `laser_data` and `wheel_data` (either empty: left out)
+/// into `png` with equal axes.
+std::string trajectoryPlotScript(const std::string& png, const std::string& title,
+                                 const std::string& laser_data, const std::string& wheel_data);
+
+/// Plots both trajectories into `png` (gnuplot), the wheels' started at the laser's first pose.
+bool plotTrajectories(const std::string& png, const std::string& title, const std::vector<StampedPose>& laser,
+                      const std::vector<StampedPose>& wheel);
+
+}  // namespace hglasm

@@ -1,0 +1,107 @@
+#include "hglasm_odometry/evaluation/trajectory.h"
+
+#include <cstdio>
+#include <fstream>
+
+#include "hglasm_odometry/evaluation/gnuplot.h"
+
+namespace hglasm {
+
+std::vector<StampedPose> trajectoryAt(const OdometryBuffer& odometry, const std::vector<double>& stamps,
+                                      double max_extrapolation, double shift) {
+  std::vector<StampedPose> trajectory;
+  for (double stamp : stamps) {
+    StampedPose pose;
+    pose.stamp = stamp;
+    if (odometry.poseAt(stamp + shift, max_extrapolation, &pose.pose)) trajectory.push_back(pose);
+  }
+  return trajectory;
+}
+
+std::vector<StampedPose> followedBy(std::vector<StampedPose> trajectory, const Pose2D& offset) {
+  for (auto& stamped : trajectory) stamped.pose = stamped.pose * offset;
+  return trajectory;
+}
+
+std::vector<StampedPose> startedAt(std::vector<StampedPose> trajectory, const Pose2D& start) {
+  if (trajectory.empty()) return trajectory;
+  const Pose2D move = start * trajectory.front().pose.inverse();
+  for (auto& stamped : trajectory) stamped.pose = move * stamped.pose;
+  return trajectory;
+}
+
+bool writeTrajectory(const std::string& path, const std::vector<StampedPose>& trajectory,
+                     const std::vector<Eigen::Matrix3d>* increment_covariances) {
+  std::FILE* file = std::fopen(path.c_str(), "w");
+  if (!file) return false;
+  for (std::size_t i = 0; i < trajectory.size(); ++i) {
+    const StampedPose& pose = trajectory[i];
+    std::fprintf(file, "%.6f %.6f %.6f %.6f", pose.stamp, pose.pose.x, pose.pose.y, pose.pose.theta);
+    if (increment_covariances && i < increment_covariances->size()) {
+      const Eigen::Matrix3d& c = (*increment_covariances)[i];
+      std::fprintf(file, " %.6g %.6g %.6g %.6g %.6g %.6g", c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2),
+                   c(2, 2));
+    }
+    std::fprintf(file, "\n");
+  }
+  return std::fclose(file) == 0;
+}
+
+bool writeTrackerTrace(const std::string& path, const std::vector<TrackerUpdate>& updates) {
+  std::FILE* file = std::fopen(path.c_str(), "w");
+  if (!file) return false;
+  std::fprintf(file,
+               "# stamp x y theta prediction matched fallback doubted leap rejected keyframe map_keyframes "
+               "box_x box_y box_theta population mahalanobis fitness status mbicp_iterations noise_xy "
+               "noise_theta guess_x guess_y guess_theta leap_probability vx vy wz time_offset\n");
+  for (const auto& u : updates) {
+    std::fprintf(file,
+                 "%.6f %.4f %.4f %.5f %s %d %d %d %d %d %d %d %.3f %.3f %.3f %d %.2f %.3f %s %d %.3g %.3g "
+                 "%.4f %.4f %.5f %.3g %.4f %.4f %.4f %.3f\n",
+                 u.stamp, u.pose.x, u.pose.y, u.pose.theta, toString(u.prediction), u.matched, u.fallback,
+                 u.prediction_doubted, u.leap, u.jump_rejected, u.new_keyframe, u.map_keyframes,
+                 u.search.box.half_x, u.search.box.half_y, u.search.box.half_theta, u.search.population,
+                 u.prior_mahalanobis, u.fitness_ratio, toString(u.match.status), u.match.iterations,
+                 u.noise_scale.xy, u.noise_scale.theta, u.guess.x, u.guess.y, u.guess.theta,
+                 u.leap_probability, u.velocity.x(), u.velocity.y(), u.velocity.z(), u.odometry_time_offset);
+  }
+  return std::fclose(file) == 0;
+}
+
+std::string trajectoryPlotScript(const std::string& png, const std::string& title,
+                                 const std::string& laser_data, const std::string& wheel_data) {
+  std::string script = "set terminal pngcairo size 1200,1000 font ',10'\nset output " + gnuplotQuote(png) +
+                       "\nset title " + gnuplotQuote(title) +
+                       " noenhanced\nset size ratio -1\nset grid\nset key top left box opaque Left\n"
+                       "set xlabel 'x (m)'\nset ylabel 'y (m)'\nplot ";
+  if (!wheel_data.empty()) {
+    script += gnuplotQuote(wheel_data) + " using 2:3 with lines lw 1 lc rgb '#d62728' title 'wheel odometry'";
+  }
+  if (!laser_data.empty()) {
+    script += std::string(wheel_data.empty() ? "" : ", ") + gnuplotQuote(laser_data) +
+              " using 2:3 with lines lw 1 lc rgb '#1f77b4' title 'laser odometry', " +
+              gnuplotQuote(laser_data) +
+              " every ::0::0 using 2:3 with points pt 7 ps 1.5 lc rgb 'black' title 'start'";
+  }
+  return script + "\n";
+}
+
+bool plotTrajectories(const std::string& png, const std::string& title, const std::vector<StampedPose>& laser,
+                      const std::vector<StampedPose>& wheel) {
+  if (laser.empty() && wheel.empty()) return false;
+  const std::string laser_data = png + ".laser.txt", wheel_data = png + ".wheel.txt",
+                    script = png + ".gnuplot";
+  const std::vector<StampedPose> aligned_wheel = laser.empty() ? wheel : startedAt(wheel, laser.front().pose);
+  bool written = writeTrajectory(laser_data, laser) && writeTrajectory(wheel_data, aligned_wheel);
+  if (written) {
+    std::ofstream out(script);
+    out << trajectoryPlotScript(png, title, laser.empty() ? "" : laser_data, wheel.empty() ? "" : wheel_data);
+    out.close();
+    written = !out.fail();
+  }
+  const bool plotted = written && runGnuplot(script);
+  for (const std::string& file : {script, laser_data, wheel_data}) std::remove(file.c_str());
+  return plotted;
+}
+
+}  // namespace hglasm
