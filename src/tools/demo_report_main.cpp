@@ -25,11 +25,14 @@
 
 #include "hglasm_odometry/Match.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
-#include "hglasm_odometry/evaluation/map_plot.h"
+#include "hglasm_odometry/evaluation/gnuplot.h"
 #include "hglasm_odometry/evaluation/relations.h"
+#include "hglasm_odometry/evaluation/statistics.h"
+#include "hglasm_odometry/evaluation/trajectory.h"
 #include "hglasm_odometry/ros/conversions.h"
 #include "hglasm_odometry/tools/argument_parser.h"
 #include "hglasm_odometry/tools/bag_reader.h"
+#include "hglasm_odometry/tools/evaluation_run.h"
 
 namespace {
 
@@ -74,14 +77,6 @@ struct Received {
   std::vector<nav_msgs::Odometry> odometry;
   std::vector<hglasm_odometry::Match> matches;
 };
-
-double percentile(std::vector<double> values, double fraction) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const std::size_t index =
-      std::min(values.size() - 1, static_cast<std::size_t>(fraction * (values.size() - 1) + 0.5));
-  return values[index];
-}
 
 void printAccuracyRow(const char* label, const hglasm::RelationStats& laser,
                       const hglasm::RelationStats& wheel) {
@@ -185,18 +180,6 @@ std::vector<hglasm::StampedPose> laserTrajectory(const std::vector<nav_msgs::Odo
   return trajectory;
 }
 
-/// Wheel odometry at the scan stamps (where it reaches them).
-std::vector<hglasm::StampedPose> wheelTrajectory(const hglasm::OdometryBuffer& wheel,
-                                                 const std::vector<double>& scan_stamps) {
-  std::vector<hglasm::StampedPose> trajectory;
-  for (double stamp : scan_stamps) {
-    hglasm::StampedPose pose;
-    pose.stamp = stamp;
-    if (wheel.poseAt(stamp, 1.0, &pose.pose)) trajectory.push_back(pose);
-  }
-  return trajectory;
-}
-
 /// Scans, time per scan, fallbacks and keyframes from ~match.
 void printRunSummary(const Options& options, const Received& received, std::size_t expected, double wall) {
   std::vector<double> total_ms;
@@ -209,9 +192,6 @@ void printRunSummary(const Options& options, const Received& received, std::size
     keyframes += m.new_keyframe;
     dropped = std::max(dropped, m.dropped_scans);
   }
-  double mean_ms = 0.0;
-  for (double v : total_ms) mean_ms += v;
-  if (!total_ms.empty()) mean_ms /= total_ms.size();
 
   std::printf("\n================ hglasm_odometry demo summary ================\n");
   std::printf("  bag                 %s\n", options.bag.c_str());
@@ -219,7 +199,8 @@ void printRunSummary(const Options& options, const Received& received, std::size
               received.odometry.size(), expected, dropped, wall);
   std::printf(
       "  time per scan       mean %.2f ms, median %.2f ms, p95 %.2f ms, max %.2f ms (~match total_ms)\n",
-      mean_ms, percentile(total_ms, 0.5), percentile(total_ms, 0.95), percentile(total_ms, 1.0));
+      hglasm::mean(total_ms), hglasm::median(total_ms), hglasm::percentile(total_ms, 0.95),
+      hglasm::percentile(total_ms, 1.0));
   std::printf("  fallbacks           %zu of %zu matches (%.1f %%)\n", fallbacks, matched,
               matched ? 100.0 * fallbacks / matched : 0.0);
   std::printf("  keyframes           %zu\n", keyframes);
@@ -267,19 +248,18 @@ void writePlot(const Options& options, const std::vector<hglasm::StampedPose>& t
     }
   }
   {
+    const std::string laser = hglasm::gnuplotQuote(dir + "/trajectory.txt");
     std::ofstream out(dir + "/trajectory.gp");
     out << "set terminal pngcairo size 1000,900 font 'Sans,11' noenhanced\n"
-        << "set output '" << dir << "/trajectory.png'\n"
-        << "set title 'hglasm_odometry on " << options.bag.substr(options.bag.find_last_of('/') + 1)
-        << ": laser odometry vs wheel odometry (from the bag)'\n"
-        << "set xlabel 'x (m)'\nset ylabel 'y (m)'\nset size ratio -1\nset grid\nset key below\n"
-        << "plot '" << dir
-        << "/wheel_odometry.txt' using 2:3 with lines lw 1.5 lc rgb '#999999' title 'wheel odometry', \\\n"
-        << "     '" << dir
-        << "/trajectory.txt' using 2:3 with lines lw 2 lc rgb '#d62728' title 'laser odometry (HGLASM-g)', "
-           "\\\n"
-        << "     '" << dir
-        << "/trajectory.txt' every ::0::0 using 2:3 with points pt 7 ps 1.5 lc rgb 'black' title 'start'\n";
+        << "set output " << hglasm::gnuplotQuote(dir + "/trajectory.png") << "\nset title "
+        << hglasm::gnuplotQuote("hglasm_odometry on " +
+                                options.bag.substr(options.bag.find_last_of('/') + 1) +
+                                ": laser odometry vs wheel odometry (from the bag)")
+        << "\nset xlabel 'x (m)'\nset ylabel 'y (m)'\nset size ratio -1\nset grid\nset key below\n"
+        << "plot " << hglasm::gnuplotQuote(dir + "/wheel_odometry.txt")
+        << " using 2:3 with lines lw 1.5 lc rgb '#999999' title 'wheel odometry', \\\n     " << laser
+        << " using 2:3 with lines lw 2 lc rgb '#d62728' title 'laser odometry (HGLASM-g)', \\\n     " << laser
+        << " every ::0::0 using 2:3 with points pt 7 ps 1.5 lc rgb 'black' title 'start'\n";
   }
   std::printf("  trajectory          %s/trajectory.txt (plot script %s/trajectory.gp)\n", dir.c_str(),
               dir.c_str());
@@ -298,22 +278,12 @@ void writeMap(const Options& options, const std::vector<hglasm::StampedPose>& tr
     std::printf("  map                 cannot read %s: %s\n", options.bag.c_str(), error.c_str());
     return;
   }
+  const std::string png = options.output_dir + "/map.png";
+  const std::string title = "hglasm_odometry on " + options.bag.substr(options.bag.find_last_of('/') + 1) +
+                            ": scans at the laser poses";
   const hglasm::ScanConversionOptions conversion =
       hglasm::conversionForMount(hglasm::ScanConversionOptions(), data.laser_upside_down);
-  const hglasm::Pose2D mount = data.has_laser_mount ? data.base_to_laser : hglasm::Pose2D();
-  std::vector<double> stamps;
-  std::vector<std::vector<Eigen::Vector2d>> scans;
-  for (const auto& bag_scan : data.scans) {
-    stamps.push_back(bag_scan.stamp);
-    scans.push_back(hglasm::scanFromRanges(bag_scan.ranges, conversion).points);
-  }
-  const std::vector<hglasm::MapView> views =
-      hglasm::laserAndWheelViews(stamps, trajectory, wheel_trajectory, mount);
-  hglasm::MapPlotOptions map_options;
-  map_options.title = "hglasm_odometry on " + options.bag.substr(options.bag.find_last_of('/') + 1) +
-                      ": scans at the laser poses";
-  const std::string png = options.output_dir + "/map.png";
-  if (hglasm::writeMapPlot(png, scans, views, map_options, &error)) {
+  if (hglasm_odometry::writeScanMap(png, title, data, conversion, trajectory, wheel_trajectory, &error)) {
     std::printf("  map                 %s\n", png.c_str());
   } else {
     std::printf("  map                 not written: %s\n", error.c_str());
@@ -360,7 +330,7 @@ int main(int argc, char** argv) {
 
   std::lock_guard<std::mutex> lock(received.mutex);
   const std::vector<hglasm::StampedPose> trajectory = laserTrajectory(received.odometry);
-  const std::vector<hglasm::StampedPose> wheel_trajectory = wheelTrajectory(wheel, scan_stamps);
+  const std::vector<hglasm::StampedPose> wheel_trajectory = hglasm::trajectoryAt(wheel, scan_stamps, 1.0);
   printRunSummary(options, received, expected, wall);
   printAccuracy(options, trajectory, wheel_trajectory);
   writePlot(options, trajectory, wheel_trajectory);

@@ -56,6 +56,7 @@
 #include "hglasm_odometry/core/scan_matcher.h"
 #include "hglasm_odometry/core/stamp_order.h"
 #include "hglasm_odometry/evaluation/relations.h"
+#include "hglasm_odometry/evaluation/trajectory.h"
 #include "hglasm_odometry/ros/conversions.h"
 #include "hglasm_odometry/ros/parameters.h"
 #include "hglasm_odometry/tools/bag_reader.h"
@@ -175,11 +176,9 @@ void readScanStampsAndWheelOdometry(Recording* rec) {
   }
   std::sort(rec->scan_stamps.begin(), rec->scan_stamps.end());
   std::sort(rec->published_stamps.begin(), rec->published_stamps.end());
-  for (const ros::Time& stamp : rec->scan_stamps) {
-    hglasm::StampedPose pose;
-    pose.stamp = stamp.toSec();
-    if (wheel.poseAt(pose.stamp, 1.0, &pose.pose)) rec->wheel_odometry.push_back(pose);
-  }
+  std::vector<double> stamps;
+  for (const ros::Time& stamp : rec->scan_stamps) stamps.push_back(stamp.toSec());
+  rec->wheel_odometry = hglasm::trajectoryAt(wheel, stamps, 1.0);
 }
 
 /// Until every scan has its odometry, match and tf, or nothing arrived for a while, or the time is up.
