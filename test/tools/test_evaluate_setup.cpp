@@ -1,0 +1,138 @@
+// evaluate's set-up: its command line, the nodelet's options from the shipped YAML (and what happens when a
+// file is missing), and the bag with the command line's overrides.
+#include "hglasm_odometry/tools/evaluate_setup.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace hglasm_odometry {
+namespace {
+
+const std::string kSource = HGLASM_SOURCE_DIR;
+const std::string kBag = kSource + "/bags/fr079_slice.bag";
+
+ArgumentParser::Result parse(const std::vector<std::string>& arguments, EvaluateArguments* args) {
+  return parseEvaluateArguments(arguments, args);
+}
+
+TEST(EvaluateSetup, ParsesTheCommandLine) {
+  EvaluateArguments args;
+  ASSERT_EQ(parse({"--bag", "b.bag", "--no-odom", "--laser-mount", "0.1,-0.2,0.3", "--max-scans", "7",
+                   "--angle-min", "-1.5", "--preset", "small", "--max-span", "5"},
+                  &args),
+            ArgumentParser::Result::kOk);
+  EXPECT_EQ(args.bag, "b.bag");
+  EXPECT_FALSE(args.use_odometry);
+  EXPECT_TRUE(args.override_mount);
+  EXPECT_DOUBLE_EQ(args.laser_mount.y, -0.2);
+  EXPECT_EQ(args.max_scans, 7u);
+  EXPECT_TRUE(args.override_angle_min);
+  EXPECT_FALSE(args.override_increment);
+  EXPECT_EQ(args.preset, "small");
+  EXPECT_EQ(args.short_span, 5.0);
+  EXPECT_FALSE(args.config_given);
+}
+
+TEST(EvaluateSetup, RefusesAMissingBagAndABadMount) {
+  EvaluateArguments args;
+  EXPECT_EQ(parse({"--out", "x.txt"}, &args), ArgumentParser::Result::kError);
+  EvaluateArguments mount;
+  EXPECT_EQ(parse({"--bag", "b.bag", "--laser-mount", "0.1,0.2"}, &mount), ArgumentParser::Result::kError);
+  hglasm::Pose2D pose;
+  std::string error;
+  EXPECT_FALSE(parseLaserMount("1,2,nan", &pose, &error));
+  EXPECT_EQ(error, "expects X,Y,YAW, got '1,2,nan'");
+}
+
+TEST(EvaluateSetup, PresetsAreNextToTheConfig) {
+  EXPECT_EQ(presetsNextTo("/a/b/laser_odometry.yaml"), "/a/b/presets.yaml");
+  EXPECT_EQ(presetsNextTo("mine.yaml"), "presets.yaml");
+}
+
+TEST(EvaluateSetup, LoadsTheShippedConfigurationAndThePresetAsked) {
+  EvaluateArguments args;
+  args.config = kSource + "/config/laser_odometry.yaml";
+  args.config_given = true;
+  LaserOdometryOptions options;
+  std::vector<std::string> warnings;
+  bool found = false;
+  std::string error;
+  ASSERT_TRUE(loadEvaluateOptions(args, &options, &warnings, &found, &error)) << error;
+  EXPECT_TRUE(found);
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_EQ(options.preset, "medium");
+  args.preset = "small";
+  LaserOdometryOptions small;
+  ASSERT_TRUE(loadEvaluateOptions(args, &small, &warnings, &found, &error)) << error;
+  EXPECT_EQ(small.preset, "small");
+  EXPECT_LT(small.tracker.matcher.genetic.population, options.tracker.matcher.genetic.population);
+}
+
+TEST(EvaluateSetup, AMissingDefaultMeansDefaultsAMissingGivenFileAnError) {
+  EvaluateArguments args;
+  args.config = "/nonexistent/laser_odometry.yaml";
+  LaserOdometryOptions options;
+  std::vector<std::string> warnings;
+  bool found = true;
+  std::string error;
+  ASSERT_TRUE(loadEvaluateOptions(args, &options, &warnings, &found, &error)) << error;
+  EXPECT_FALSE(found);
+  args.config_given = true;
+  EXPECT_FALSE(loadEvaluateOptions(args, &options, &warnings, &found, &error));
+  EXPECT_EQ(error, "cannot read /nonexistent/laser_odometry.yaml");
+}
+
+TEST(EvaluateSetup, PresetsMayBeNestedUnderAPresetsKey) {
+  const std::string presets = testing::TempDir() + "hglasm_nested_presets.yaml";
+  std::ofstream(presets) << "presets:\n  tiny:\n    genetic:\n      population: 12\n";
+  EvaluateArguments args;
+  args.config = "/nonexistent/laser_odometry.yaml";
+  args.presets = presets;
+  args.presets_given = true;
+  args.preset = "tiny";
+  LaserOdometryOptions options;
+  std::vector<std::string> warnings;
+  bool found = true;
+  std::string error;
+  ASSERT_TRUE(loadEvaluateOptions(args, &options, &warnings, &found, &error)) << error;
+  EXPECT_EQ(options.preset, "tiny");
+  EXPECT_EQ(options.tracker.matcher.genetic.population, 12);
+  std::remove(presets.c_str());
+}
+
+TEST(EvaluateSetup, InputsCarryTheOverrides) {
+  EvaluateArguments args;
+  args.bag = kBag;
+  args.relations = kSource + "/bags/fr079_slice.relations";
+  args.max_scans = 20;
+  EvaluateInputs plain;
+  std::string error;
+  ASSERT_TRUE(readEvaluateInputs(args, "", &plain, &error)) << error;
+  EXPECT_EQ(plain.data.scans.size(), 20u);
+  EXPECT_EQ(plain.relations.size(), 156u);
+  EXPECT_EQ(plain.mount_source, "from tf");
+
+  args.override_mount = true;
+  args.laser_mount = hglasm::Pose2D(0.3, 0.0, 0.1);
+  args.override_increment = true;
+  args.angle_increment = 0.02;
+  args.odom_stamp_shift = 0.5;
+  EvaluateInputs changed;
+  ASSERT_TRUE(readEvaluateInputs(args, "", &changed, &error)) << error;
+  EXPECT_EQ(changed.mount_source, "from --laser-mount");
+  EXPECT_EQ(changed.data.base_to_laser.x, 0.3);
+  for (const BagScan& scan : changed.data.scans) EXPECT_EQ(scan.ranges.angle_increment, 0.02);
+  ASSERT_EQ(changed.data.odometry.size(), plain.data.odometry.size());
+  EXPECT_NEAR(changed.data.odometry.front().stamp - plain.data.odometry.front().stamp, 0.5, 1e-9);
+
+  args.bag = "/nonexistent.bag";
+  EXPECT_FALSE(readEvaluateInputs(args, "", &changed, &error));
+}
+
+}  // namespace
+}  // namespace hglasm_odometry

@@ -1,0 +1,188 @@
+// evaluate's run and report on bags/fr079_slice.bag: the run is the nodelet's pipeline replayed pose for
+// pose, its counts add up, thinning drops scans and keeps odometry, the wheel baseline and the direct
+// pairs agree with the reference, and the report prints what the run found.
+#include "hglasm_odometry/tools/evaluation_run.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "hglasm_odometry/evaluation/trajectory.h"
+#include "hglasm_odometry/tools/evaluation_report.h"
+
+namespace hglasm_odometry {
+namespace {
+
+const std::string kSource = HGLASM_SOURCE_DIR;
+
+struct Slice {
+  BagData data;
+  std::vector<hglasm::Relation> relations;
+  LaserOdometryOptions options;
+};
+
+const Slice& slice() {
+  static const Slice loaded = [] {
+    Slice s;
+    std::string error;
+    EXPECT_TRUE(readBag(kSource + "/bags/fr079_slice.bag", BagReadOptions(), &s.data, &error)) << error;
+    EXPECT_TRUE(hglasm::readRelations(kSource + "/bags/fr079_slice.relations", &s.relations, &error))
+        << error;
+    EXPECT_TRUE(loadOptions(XmlRpc::XmlRpcValue(), &s.options, &error)) << error;
+    return s;
+  }();
+  return loaded;
+}
+
+const EvaluationRun& run() {
+  static const EvaluationRun result =
+      runEvaluation(slice().data, slice().options, slice().options.tracker, 0.0);
+  return result;
+}
+
+/// What `print` writes to a FILE*.
+template <typename Print>
+std::string printed(const Print& print) {
+  char* buffer = nullptr;
+  std::size_t size = 0;
+  std::FILE* out = open_memstream(&buffer, &size);
+  print(out);
+  std::fclose(out);
+  const std::string text(buffer, size);
+  std::free(buffer);
+  return text;
+}
+
+TEST(EvaluationRun, IsTheNodeletsPipelineReplayed) {
+  const Slice& s = slice();
+  hglasm::OdometryPipeline pipeline(s.options.tracker, s.options.odometry_wait > 0.0);
+  setLaserMount(s.data, &pipeline);
+  ReplayOptions replay;
+  replay.odometry_wait = s.options.odometry_wait;
+  replay.queue_size = static_cast<std::size_t>(s.options.queue_size);
+  std::vector<hglasm::StampedPose> expected;
+  replayBag(s.data, &pipeline, replay, [&expected](const ReplayedScan& replayed) {
+    if (replayed.update.tracker.published)
+      expected.push_back({replayed.scan->stamp, replayed.update.tracker.pose});
+  });
+  ASSERT_EQ(run().trajectory.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(run().trajectory[i].stamp, expected[i].stamp);
+    EXPECT_EQ(run().trajectory[i].pose.x, expected[i].pose.x) << i;
+    EXPECT_EQ(run().trajectory[i].pose.theta, expected[i].pose.theta) << i;
+  }
+}
+
+TEST(EvaluationRun, CountsAddUp) {
+  const EvaluationRun& r = run();
+  EXPECT_EQ(r.processed, slice().data.scans.size());
+  EXPECT_EQ(r.updates.size(), r.trajectory.size());
+  EXPECT_EQ(r.total_ms.size(), r.processed);
+  EXPECT_EQ(r.prealign_ms.size(), static_cast<std::size_t>(r.matched));
+  EXPECT_EQ(r.table_ms.size(), static_cast<std::size_t>(r.keyframes));
+  int statuses = 0;
+  for (const auto& entry : r.statuses) statuses += entry.second;
+  EXPECT_EQ(statuses, r.matched);
+  EXPECT_EQ(incrementCovariances(r).size(), r.trajectory.size());
+  EXPECT_EQ(r.first_warnings.size(), std::min<std::size_t>(20, static_cast<std::size_t>(r.warnings)));
+}
+
+TEST(EvaluationRun, ThinningDropsScansAndKeepsTheOdometry) {
+  const BagData& data = slice().data;
+  std::size_t skipped = 0;
+  const std::vector<BagArrival> kept = thinnedArrivals(data, 0.5, &skipped);
+  std::size_t scans = 0, odometry = 0;
+  for (const BagArrival& arrival : kept) (arrival.scan ? scans : odometry)++;
+  EXPECT_EQ(odometry, data.odometry.size());
+  EXPECT_EQ(scans + skipped, data.scans.size());
+  EXPECT_GT(skipped, data.scans.size() / 2);  // 4.7 Hz thinned to at most 2 Hz
+  const EvaluationRun thinned = runEvaluation(data, slice().options, slice().options.tracker, 0.5);
+  EXPECT_EQ(thinned.skipped, skipped);
+  EXPECT_EQ(thinned.processed, scans);
+}
+
+TEST(EvaluationRun, WheelBaselineIsTheBagsOdometryAtTheScanStamps) {
+  const BagData& data = slice().data;
+  const std::vector<hglasm::StampedPose> wheel = wheelTrajectory(data);
+  ASSERT_EQ(wheel.size(), data.scans.size());  // the slice's odometry covers its scans
+  hglasm::OdometryBuffer buffer(1e9);
+  for (const BagOdometry& sample : data.odometry) buffer.add(sample.stamp, sample.pose);
+  hglasm::Pose2D later;
+  ASSERT_TRUE(buffer.poseAt(data.scans[10].stamp + 0.2, 0.0, &later));
+  const std::vector<hglasm::StampedPose> shifted = wheelTrajectory(data, 0.2);
+  EXPECT_EQ(shifted[10].stamp, data.scans[10].stamp);
+  EXPECT_EQ(shifted[10].pose.x, later.x);
+}
+
+TEST(EvaluationRun, DirectPairsAgreeWithTheReference) {
+  std::vector<hglasm::Pose2D> motions;
+  std::vector<bool> valid;
+  directPairMotions(slice().options.tracker, slice().data, slice().relations, 10.0, &motions, &valid);
+  const hglasm::RelationStats direct =
+      hglasm::evaluateRelativeMotions(slice().relations, motions, valid, 10.0);
+  EXPECT_GT(direct.count, 100);
+  EXPECT_LT(direct.trans_mean, 0.05);
+}
+
+TEST(EvaluationReport, PrintsTheMetricAndTheSummaryOfTheRun) {
+  const Slice& s = slice();
+  const std::vector<hglasm::StampedPose> wheel = wheelTrajectory(s.data);
+  const RelationsReport report = evaluateRun(s.relations, run(), wheel, s.data, 10.0);
+  EXPECT_EQ(report.laser_all.count + report.laser_all.missing, static_cast<int>(s.relations.size()));
+  EXPECT_TRUE(report.laser_frame);  // fr079's laser is 4 cm ahead of the base
+  EXPECT_FALSE(report.has_direct_pairs);
+  ASSERT_EQ(report.worst.size(), 5u);
+  EXPECT_GE(report.worst[0].laser.trans, report.worst[4].laser.trans);
+  EXPECT_LT(report.laser_short.trans_mean, report.wheel_short.trans_mean * 2.0);
+
+  const std::string text = printed([&](std::FILE* out) {
+    printRelationsReport(out, "r.relations", s.relations, report, "base_link", true);
+    printSummary(out, "medium", run(), report);
+  });
+  EXPECT_NE(text.find("relations     r.relations: 156 (Kümmerle"), std::string::npos) << text;
+  EXPECT_NE(text.find("  laser frame (the same trajectories"), std::string::npos) << text;
+  EXPECT_NE(text.find("SUMMARY preset=medium scans=" + std::to_string(run().processed) + " "),
+            std::string::npos);
+  char all[64];
+  std::snprintf(all, sizeof all, " all_t=%.4f all_r=%.3f ", report.laser_all.trans_mean,
+                report.laser_all.rot_mean_deg);
+  EXPECT_NE(text.find(all), std::string::npos) << text;
+}
+
+TEST(EvaluationReport, PrintsTheRunWithItsWarningsWhenAsked) {
+  EvaluationRun r;
+  r.processed = 4;
+  r.matched = 3;
+  r.total_ms = {1.0, 2.0, 3.0, 10.0};
+  r.warnings = 1;
+  r.first_warnings = {{12.5, "a warning"}};
+  const std::string loud = printed([&](std::FILE* out) { printRun(out, r, 2.0, true); });
+  EXPECT_EQ(loud.rfind("  warning at 12.500000: a warning\n", 0), 0u) << loud;
+  EXPECT_NE(loud.find("\nscans         4 processed, 3 matched,"), std::string::npos) << loud;
+  char total[128];  // median 2.5, nearest-rank p99 and max 10, mean 4
+  std::snprintf(total, sizeof total, "  %-29s %6d %8.3f %8.3f %8.3f %8.3f\n", "total per scan (CPU)", 4, 2.5,
+                10.0, 10.0, 4.0);
+  EXPECT_NE(loud.find(total), std::string::npos) << loud;
+  const std::string quiet = printed([&](std::FILE* out) { printRun(out, r, 2.0, false); });
+  EXPECT_EQ(quiet.find("warning at"), std::string::npos);
+}
+
+TEST(EvaluationRun, WritesTheScanMap) {
+  if (std::system("gnuplot --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "no gnuplot";
+  const std::string png = testing::TempDir() + "hglasm_scan_map.png";
+  std::string error;
+  ASSERT_TRUE(writeScanMap(png, "slice", slice().data,
+                           pipelineConversion(slice().options.tracker, slice().data), run().trajectory,
+                           wheelTrajectory(slice().data), &error))
+      << error;
+  std::FILE* file = std::fopen(png.c_str(), "r");
+  EXPECT_NE(file, nullptr) << png;
+  if (file) std::fclose(file);
+  std::remove(png.c_str());
+}
+
+}  // namespace
+}  // namespace hglasm_odometry
