@@ -78,8 +78,9 @@ ArgumentParser::Result parseEvaluateArguments(const std::vector<std::string>& ar
   parser.addFlag("--direct-pairs", &args->direct_pairs);
   parser.addOption("--max-scans", &args->max_scans);
   parser.addOption("--odom-stamp-shift", &args->odom_stamp_shift);
-  parser.addOption("--angle-increment", &args->angle_increment, &args->override_increment);
-  parser.addOption("--angle-min", &args->angle_min, &args->override_angle_min);
+  parser.addOption("--angle-increment", &args->beam_angles.angle_increment,
+                   &args->beam_angles.angle_increment_given);
+  parser.addOption("--angle-min", &args->beam_angles.angle_min, &args->beam_angles.angle_min_given);
   parser.addOption("--laser-mount", [args](const std::string& text, std::string* error) {
     args->override_mount = parseLaserMount(text, &args->laser_mount, error);
     return args->override_mount;
@@ -150,10 +151,7 @@ bool readEvaluateInputs(const EvaluateArguments& args, const std::string& base_f
     data.base_to_laser = args.laser_mount;
     inputs->mount_source = "from --laser-mount";
   }
-  for (BagScan& scan : data.scans) {
-    if (args.override_increment) scan.ranges.angle_increment = args.angle_increment;
-    if (args.override_angle_min) scan.ranges.angle_min = args.angle_min;
-  }
+  for (BagScan& scan : data.scans) args.beam_angles.applyTo(&scan.ranges);
   if (args.odom_stamp_shift != 0.0) shiftOdometry(args.odom_stamp_shift, &data);
   return true;
 }

@@ -86,14 +86,15 @@ ArgumentParser makeParser(SuccessRatioArguments* args) {
   parser.addOption("--curve-csv", &args->curve_csv);
   parser.addOption("--max-scans", &args->max_scans);
   parser.addOption("--min-points", &args->min_points, 3);
-  parser.addOption("--angle-min", &args->angle_min, &args->override_angle_min);
-  parser.addOption("--angle-increment", [args](const std::string& text, std::string* error) {
+  BeamAngleOverrides& beams = args->beam_angles;
+  parser.addOption("--angle-min", &beams.angle_min, &beams.angle_min_given);
+  parser.addOption("--angle-increment", [&beams](const std::string& text, std::string* error) {
     char* end = nullptr;
-    args->angle_increment = std::strtod(text.c_str(), &end);
-    args->override_increment =
-        !text.empty() && *end == '\0' && std::isfinite(args->angle_increment) && args->angle_increment != 0.0;
-    if (!args->override_increment) *error = "expected a non-zero number, got '" + text + "'";
-    return args->override_increment;
+    beams.angle_increment = std::strtod(text.c_str(), &end);
+    beams.angle_increment_given =
+        !text.empty() && *end == '\0' && std::isfinite(beams.angle_increment) && beams.angle_increment != 0.0;
+    if (!beams.angle_increment_given) *error = "expected a non-zero number, got '" + text + "'";
+    return beams.angle_increment_given;
   });
   parser.addOption("--title", &args->title);
   parser.addOption("--curve-algorithms", &args->curve_algorithms);
@@ -289,10 +290,7 @@ bool readSuccessRatioScans(const SuccessRatioArguments& args, std::vector<hglasm
     *error = "no scans read";
     return false;
   }
-  for (hglasm::RangeScan& scan : *scans) {
-    if (args.override_angle_min) scan.angle_min = args.angle_min;
-    if (args.override_increment) scan.angle_increment = args.angle_increment;
-  }
+  for (hglasm::RangeScan& scan : *scans) args.beam_angles.applyTo(&scan);
   return true;
 }
 

@@ -31,8 +31,8 @@ TEST(EvaluateSetup, ParsesTheCommandLine) {
   EXPECT_TRUE(args.override_mount);
   EXPECT_DOUBLE_EQ(args.laser_mount.y, -0.2);
   EXPECT_EQ(args.max_scans, 7u);
-  EXPECT_TRUE(args.override_angle_min);
-  EXPECT_FALSE(args.override_increment);
+  EXPECT_TRUE(args.beam_angles.angle_min_given);
+  EXPECT_FALSE(args.beam_angles.angle_increment_given);
   EXPECT_EQ(args.preset, "small");
   EXPECT_EQ(args.short_span, 5.0);
   EXPECT_FALSE(args.config_given);
@@ -119,8 +119,8 @@ TEST(EvaluateSetup, InputsCarryTheOverrides) {
 
   args.override_mount = true;
   args.laser_mount = hglasm::Pose2D(0.3, 0.0, 0.1);
-  args.override_increment = true;
-  args.angle_increment = 0.02;
+  args.beam_angles.angle_increment_given = true;
+  args.beam_angles.angle_increment = 0.02;
   args.odom_stamp_shift = 0.5;
   EvaluateInputs changed;
   ASSERT_TRUE(readEvaluateInputs(args, "", &changed, &error)) << error;

@@ -74,8 +74,8 @@ TEST(SuccessRatioSetup, ReadsTheBagsScansWithTheOverrides) {
   SuccessRatioArguments args;
   args.bag = HGLASM_SOURCE_DIR "/bags/fr079_slice.bag";
   args.max_scans = 10;
-  args.override_angle_min = true;
-  args.angle_min = -1.0;
+  args.beam_angles.angle_min_given = true;
+  args.beam_angles.angle_min = -1.0;
   std::vector<hglasm::RangeScan> scans;
   std::vector<hglasm::Pose2D> offsets;
   std::ostringstream log;

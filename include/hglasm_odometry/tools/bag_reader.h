@@ -45,6 +45,18 @@ struct BagData {
   std::string base_frame;          ///< child frame of the odometry messages
 };
 
+/// Beam angles given on a tool's command line in place of the scans' own (a driver that states them wrong).
+struct BeamAngleOverrides {
+  bool angle_min_given = false;
+  double angle_min = 0.0;  ///< radians
+  bool angle_increment_given = false;
+  double angle_increment = 0.0;  ///< radians
+  void applyTo(hglasm::RangeScan* scan) const {
+    if (angle_min_given) scan->angle_min = angle_min;
+    if (angle_increment_given) scan->angle_increment = angle_increment;
+  }
+};
+
 struct BagReadOptions {
   std::string scan_topic = "/scan";
   std::string odom_topic = "/odom";  ///< empty: do not read odometry

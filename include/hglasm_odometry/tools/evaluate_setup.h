@@ -31,10 +31,7 @@ struct EvaluateArguments {
   hglasm::Pose2D laser_mount;
   std::size_t max_scans = 0;
   double odom_stamp_shift = 0.0;
-  bool override_increment = false;
-  double angle_increment = 0.0;
-  bool override_angle_min = false;
-  double angle_min = 0.0;
+  BeamAngleOverrides beam_angles;
   double short_span = 10.0;
   bool direct_pairs = false;
   bool quiet = false;

@@ -40,10 +40,7 @@ struct SuccessRatioArguments {
   std::string curve_csv;
   std::size_t max_scans = 0;
   int min_points = 40;
-  bool override_angle_min = false;
-  double angle_min = 0.0;
-  bool override_increment = false;
-  double angle_increment = 0.0;
+  BeamAngleOverrides beam_angles;
   std::string title;
   bool quiet = false;
 };
