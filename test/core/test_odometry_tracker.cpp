@@ -58,9 +58,10 @@ class SimulatedRobot {
  public:
   SimulatedRobot(const TrackerOptions& options, Path path)
       : tracker_(options),
-        path_(std::move(path)),
+        path_(path),
         world_(hglasm_test::room()),
-        laser_(hglasm_test::halfCircleLaser()) {}
+        laser_(hglasm_test::halfCircleLaser()),
+        wheels_(std::move(path)) {}
 
   void setMount(const Pose2D& mount) {
     mount_ = mount;
@@ -71,9 +72,7 @@ class SimulatedRobot {
   /// `turn_scale` of every turn (a skid-steer robot's wheels slip as it turns).
   void enableOdometry(double scale_error, double drift_per_metre, double turn_scale = 1.0) {
     odometry_ = true;
-    scale_error_ = scale_error;
-    drift_per_metre_ = drift_per_metre;
-    turn_scale_ = turn_scale;
+    wheels_.setErrors(scale_error, drift_per_metre, turn_scale);
   }
 
   /// A gyro at 200 Hz: the true yaw rate plus a constant `bias` (rad/s) and white noise of
@@ -87,7 +86,7 @@ class SimulatedRobot {
   void disableGyro() { gyro_ = false; }
 
   Pose2D truth(double t) const { return path_(t); }
-  Pose2D odometryPose() const { return odometry_pose_; }
+  Pose2D odometryPose() const { return wheels_.pose(); }
 
   /// A laser whose sweep lasts `seconds` from the first beam to the last (0: all beams at once).
   void setSweepTime(double seconds) { sweep_time_ = seconds; }
@@ -105,19 +104,8 @@ class SimulatedRobot {
 
   /// Advances to time t: wheel odometry at 50 Hz up to t, then one scan at t (or `scan` if given).
   TrackerUpdate step(double t, const hglasm::Scan* scan = nullptr) {
-    if (odometry_) {
-      while (odometry_time_ + 0.02 <= t + 1e-9) {
-        const Pose2D previous = path_(odometry_time_);
-        odometry_time_ += 0.02;
-        const Pose2D motion = hglasm_test::relativeByHand(previous, path_(odometry_time_));
-        const double distance = std::hypot(motion.x, motion.y);
-        const Pose2D biased =
-            hglasm_test::rawPose((1.0 + scale_error_) * motion.x, (1.0 + scale_error_) * motion.y,
-                                 turn_scale_ * motion.theta + drift_per_metre_ * distance);
-        odometry_pose_ = hglasm_test::composeByHand(odometry_pose_, biased);
-        tracker_.addOdometry(odometry_time_, odometry_pose_);
-      }
-    }
+    if (odometry_)
+      wheels_.advance(t, [this](double time, const Pose2D& pose) { tracker_.addOdometry(time, pose); });
     // As live, the scan is processed once its sweep is over: the IMU's samples of the sweep are there.
     while (gyro_ && gyro_time_ + kGyroPeriod <= t + sweep_time_ + 1e-9) {
       gyro_time_ += kGyroPeriod;
@@ -136,18 +124,14 @@ class SimulatedRobot {
   hglasm_test::LaserSpec laser_;
   Pose2D mount_;
   double sweep_time_ = 0.0;
+  hglasm_test::SimulatedWheels wheels_;  // integrated from the identity at t = 0
   bool odometry_ = false;
-  double scale_error_ = 0.0;
-  double drift_per_metre_ = 0.0;
-  double turn_scale_ = 1.0;
-  double odometry_time_ = 0.0;
   static constexpr double kGyroPeriod = 0.005;  // s
   bool gyro_ = false;
   double gyro_bias_ = 0.0;
   double gyro_sigma_ = 0.0;
   double gyro_time_ = -kGyroPeriod;
   std::mt19937 gyro_random_;
-  Pose2D odometry_pose_;
 };
 
 TrackerOptions withoutOdometry() {

@@ -81,7 +81,11 @@ class Robot {
  public:
   Robot(const TrackerOptions& options, Path path, LaserSpec laser = hglasm_test::halfCircleLaser(),
         hglasm_test::World world = hglasm_test::room())
-      : pipeline_(options), path_(std::move(path)), world_(std::move(world)), laser_(laser) {}
+      : pipeline_(options),
+        path_(path),
+        wheels_(std::move(path), -0.02),
+        world_(std::move(world)),
+        laser_(laser) {}
 
   void setLaser(const LaserSpec& laser) { laser_ = laser; }
   /// Exact wheel odometry (the truth), optionally with a permanent offset added from `jump_time` on.
@@ -92,7 +96,7 @@ class Robot {
     jump_ = jump;
   }
   /// The wheels report this path instead of the true one (their own errors).
-  void setOdometryPath(Path path) { odometry_path_ = std::move(path); }
+  void setOdometryPath(Path path) { wheels_.setPath(std::move(path)); }
   /// Odometry samples are handed to the tracker only `delay` seconds after their stamp.
   void setOdometryDelay(double delay) { odometry_delay_ = delay; }
 
@@ -114,12 +118,10 @@ class Robot {
   TrackerUpdate stepAt(double t, double stamp, const RangeScan* ranges = nullptr) {
     last_time_ = t;
     if (odometry_) {
-      while (odometry_time_ + 0.02 <= t - odometry_delay_ + 1e-9) {
-        odometry_time_ += 0.02;
-        Pose2D pose = odometry_path_ ? odometry_path_(odometry_time_) : path_(odometry_time_);
-        if (odometry_time_ >= jump_time_) pose = hglasm_test::composeByHand(jump_, pose);
-        pipeline_.addOdometry(odometry_time_ + stamp_offset_, pose);
-      }
+      wheels_.advance(t - odometry_delay_, [this](double time, const Pose2D& pose) {
+        pipeline_.addOdometry(time + stamp_offset_,
+                              time >= jump_time_ ? hglasm_test::composeByHand(jump_, pose) : pose);
+      });
     }
     const RangeScan scan = ranges ? *ranges : rangesAt(t);
     const hglasm::PipelineUpdate result = pipeline_.processScan(stamp, scan);
@@ -136,11 +138,10 @@ class Robot {
  private:
   OdometryPipeline pipeline_;
   Path path_;
-  Path odometry_path_;  // empty: the wheels report the truth
+  hglasm_test::SimulatedWheels wheels_;  // exact: the truth or setOdometryPath's; the first sample at t = 0
   hglasm_test::World world_;
   LaserSpec laser_;
   bool odometry_ = false;
-  double odometry_time_ = -0.02;  // the first sample is at t = 0
   double odometry_delay_ = 0.0;
   double stamp_offset_ = 0.0;
   double last_time_ = 0.0;

@@ -1,5 +1,6 @@
-// Shared helpers of the core tests and the benchmark: a simulated laser in polygonal worlds, angle and pose
-// error helpers, and the loader of the real-scan fixtures in test/data. Header-only, ROS-free.
+// Shared helpers of the core tests, the rostests and the benchmark: a simulated laser in polygonal worlds,
+// simulated wheels, angle and pose error helpers, and the loader of the real-scan fixtures in test/data.
+// Header-only, ROS-free.
 //
 // The simulation deliberately does not use the core (no Pose2D operators, no scanFromRanges), so a bug in
 // the core cannot cancel itself out in the tests.
@@ -157,6 +158,69 @@ inline std::function<hglasm::Pose2D(double)> squareWithSpins(double turn_rate) {
 inline double yawRate(const std::function<hglasm::Pose2D(double)>& path, double t) {
   return angleDiff(path(t + 5e-4).theta, path(t - 5e-4).theta) / 1e-3;
 }
+
+// ------------------------------------------------------------------ the simulated wheels
+
+/// The wheel odometry of a robot driving `path`, a sample every kPeriod s after `start`: the path itself
+/// (exact wheels), or after setErrors the path's increments integrated from `start_pose` with a scale
+/// error, a heading drift per metre and a share of every turn (worn or slipping wheels). The robots of the
+/// core tests and the rostests all drive their wheels with it.
+class SimulatedWheels {
+ public:
+  static constexpr double kPeriod = 0.02;  // 50 Hz
+
+  explicit SimulatedWheels(std::function<hglasm::Pose2D(double)> path, double start = 0.0,
+                           const hglasm::Pose2D& start_pose = hglasm::Pose2D())
+      : path_(std::move(path)), time_(start), pose_(start_pose) {}
+
+  /// Integrated wheels from now on, from the pose they report now.
+  void setErrors(double scale_error, double drift_per_metre, double turn_scale) {
+    integrated_ = true;
+    scale_error_ = scale_error;
+    drift_per_metre_ = drift_per_metre;
+    turn_scale_ = turn_scale;
+  }
+  /// Exact wheels again.
+  void setExact() { integrated_ = false; }
+  /// The wheels report this path from now on.
+  void setPath(std::function<hglasm::Pose2D(double)> path) { path_ = std::move(path); }
+  /// Samples start again after `start`, integrated ones from the path's pose there.
+  void restart(double start) {
+    time_ = start;
+    pose_ = path_(start);
+  }
+
+  double time() const { return time_; }
+  /// The last sample of integrated wheels.
+  const hglasm::Pose2D& pose() const { return pose_; }
+
+  /// Calls sample(time, pose) for each sample up to `until` (1 ns tolerance).
+  template <typename Sample>
+  void advance(double until, const Sample& sample) {
+    while (time_ + kPeriod <= until + 1e-9) {
+      const double before = time_;
+      time_ += kPeriod;
+      if (!integrated_) {
+        sample(time_, path_(time_));
+        continue;
+      }
+      const hglasm::Pose2D motion = relativeByHand(path_(before), path_(time_));
+      const double distance = std::hypot(motion.x, motion.y);
+      pose_ = composeByHand(pose_, rawPose((1.0 + scale_error_) * motion.x, (1.0 + scale_error_) * motion.y,
+                                           turn_scale_ * motion.theta + drift_per_metre_ * distance));
+      sample(time_, pose_);
+    }
+  }
+
+ private:
+  std::function<hglasm::Pose2D(double)> path_;
+  double time_;
+  hglasm::Pose2D pose_;
+  bool integrated_ = false;
+  double scale_error_ = 0.0;
+  double drift_per_metre_ = 0.0;
+  double turn_scale_ = 1.0;
+};
 
 // ------------------------------------------------------------------ the simulated laser
 

@@ -177,7 +177,8 @@ struct RobotSetup {
 
 class Robot {
  public:
-  Robot(ros::NodeHandle& nh, RobotSetup setup) : setup_(std::move(setup)), world_(hglasm_test::room()) {
+  Robot(ros::NodeHandle& nh, RobotSetup setup)
+      : setup_(std::move(setup)), world_(hglasm_test::room()), wheels_(setup_.path, -1e9) {
     scan_pub_ = nh.advertise<sensor_msgs::LaserScan>(setup_.scan_topic, 100);
     if (!setup_.wheel_topic.empty()) wheel_pub_ = nh.advertise<nav_msgs::Odometry>(setup_.wheel_topic, 1000);
     odom_sub_ = nh.subscribe<nav_msgs::Odometry>(setup_.instance + "/odom", 10000,
@@ -222,33 +223,29 @@ class Robot {
     const double stamp_offset = stamp_until.toSec() - t_until;
     // Restart when the stamps went back or onto another timeline (ros::Time rounds to nanoseconds: offsets
     // that differ by less are the same timeline).
-    if (wheel_t_ > t_until + 1e-9 || std::abs(stamp_offset - wheel_stamp_offset_) > 1e-6) {
-      wheel_t_ = t_until - 0.1;
-      slipping_pose_ = truth(wheel_t_);
+    if (wheels_.time() > t_until + 1e-9 || std::abs(stamp_offset - wheel_stamp_offset_) > 1e-6) {
+      wheels_.restart(t_until - 0.1);
     }
     wheel_stamp_offset_ = stamp_offset;
-    while (wheel_t_ + 0.02 <= t_until + 1e-9) {
-      wheel_t_ += 0.02;
-      // Slipping wheels integrate their own increments; exact ones are the truth itself (no rounding).
-      const Pose2D increment = hglasm_test::relativeByHand(truth(wheel_t_ - 0.02), truth(wheel_t_));
-      slipping_pose_ = hglasm_test::composeByHand(
-          slipping_pose_,
-          hglasm_test::rawPose(increment.x, increment.y, wheel_turn_scale_ * increment.theta));
-      const Pose2D pose = hglasm_test::composeByHand(
-          wheel_offset_, wheel_turn_scale_ == 1.0 ? truth(wheel_t_) : slipping_pose_);
+    wheels_.advance(t_until, [&](double time, const Pose2D& pose) {
       nav_msgs::Odometry msg;
-      msg.header.stamp = ros::Time(wheel_t_ + stamp_offset);
+      msg.header.stamp = ros::Time(time + stamp_offset);
       msg.header.frame_id = "wheel_odom";
       msg.child_frame_id = setup_.base_frame;
-      msg.pose.pose = poseMsgFromPose2D(pose);
+      msg.pose.pose = poseMsgFromPose2D(hglasm_test::composeByHand(wheel_offset_, pose));
       wheel_pub_.publish(msg);
-    }
+    });
   }
   void setWheelOffset(const Pose2D& offset) { wheel_offset_ = offset; }
   /// Wheels that count `scale` of every turn (a skid-steer robot's slip), from the next sample on.
   void setWheelTurnScale(double scale) {
-    wheel_turn_scale_ = scale;
-    slipping_pose_ = truth(wheel_t_);
+    // Slipping wheels integrate their own increments; exact ones are the truth itself (no rounding).
+    wheels_.restart(wheels_.time());
+    if (scale == 1.0) {
+      wheels_.setExact();
+    } else {
+      wheels_.setErrors(0.0, 0.0, scale);
+    }
   }
 
   void publishScan(const sensor_msgs::LaserScan& scan) { scan_pub_.publish(scan); }
@@ -312,11 +309,9 @@ class Robot {
   std::vector<nav_msgs::Odometry> odom_;
   std::vector<geometry_msgs::PoseWithCovarianceStamped> pose_;
   std::vector<Match> match_;
-  double wheel_t_ = -1e9;
+  hglasm_test::SimulatedWheels wheels_;
   double wheel_stamp_offset_ = 0.0;
   Pose2D wheel_offset_;
-  double wheel_turn_scale_ = 1.0;
-  Pose2D slipping_pose_;
 };
 
 /// Clockwise circle of radius 1.5 m through the origin at 0.5 m/s (clear of the room's obstacles).
