@@ -54,37 +54,49 @@ TEST(EvaluateSetup, PresetsAreNextToTheConfig) {
   EXPECT_EQ(presetsNextTo("mine.yaml"), "presets.yaml");
 }
 
+/// What loadEvaluateOptions gives for `args`.
+struct Loaded {
+  bool ok = false;
+  LaserOdometryOptions options;
+  std::vector<std::string> warnings;
+  bool config_found = false;
+  std::string error;
+};
+
+Loaded load(const EvaluateArguments& args) {
+  Loaded loaded;
+  loaded.ok =
+      loadEvaluateOptions(args, &loaded.options, &loaded.warnings, &loaded.config_found, &loaded.error);
+  return loaded;
+}
+
 TEST(EvaluateSetup, LoadsTheShippedConfigurationAndThePresetAsked) {
   EvaluateArguments args;
   args.config = kSource + "/config/laser_odometry.yaml";
   args.config_given = true;
-  LaserOdometryOptions options;
-  std::vector<std::string> warnings;
-  bool found = false;
-  std::string error;
-  ASSERT_TRUE(loadEvaluateOptions(args, &options, &warnings, &found, &error)) << error;
-  EXPECT_TRUE(found);
-  EXPECT_TRUE(warnings.empty());
-  EXPECT_EQ(options.preset, "medium");
+  const Loaded shipped = load(args);
+  ASSERT_TRUE(shipped.ok) << shipped.error;
+  EXPECT_TRUE(shipped.config_found);
+  EXPECT_TRUE(shipped.warnings.empty());
+  EXPECT_EQ(shipped.options.preset, "medium");
   args.preset = "small";
-  LaserOdometryOptions small;
-  ASSERT_TRUE(loadEvaluateOptions(args, &small, &warnings, &found, &error)) << error;
-  EXPECT_EQ(small.preset, "small");
-  EXPECT_LT(small.tracker.matcher.genetic.population, options.tracker.matcher.genetic.population);
+  const Loaded small = load(args);
+  ASSERT_TRUE(small.ok) << small.error;
+  EXPECT_EQ(small.options.preset, "small");
+  EXPECT_LT(small.options.tracker.matcher.genetic.population,
+            shipped.options.tracker.matcher.genetic.population);
 }
 
 TEST(EvaluateSetup, AMissingDefaultMeansDefaultsAMissingGivenFileAnError) {
   EvaluateArguments args;
   args.config = "/nonexistent/laser_odometry.yaml";
-  LaserOdometryOptions options;
-  std::vector<std::string> warnings;
-  bool found = true;
-  std::string error;
-  ASSERT_TRUE(loadEvaluateOptions(args, &options, &warnings, &found, &error)) << error;
-  EXPECT_FALSE(found);
+  const Loaded defaults = load(args);
+  ASSERT_TRUE(defaults.ok) << defaults.error;
+  EXPECT_FALSE(defaults.config_found);
   args.config_given = true;
-  EXPECT_FALSE(loadEvaluateOptions(args, &options, &warnings, &found, &error));
-  EXPECT_EQ(error, "cannot read /nonexistent/laser_odometry.yaml");
+  const Loaded missing = load(args);
+  EXPECT_FALSE(missing.ok);
+  EXPECT_EQ(missing.error, "cannot read /nonexistent/laser_odometry.yaml");
 }
 
 TEST(EvaluateSetup, PresetsMayBeNestedUnderAPresetsKey) {
@@ -95,13 +107,10 @@ TEST(EvaluateSetup, PresetsMayBeNestedUnderAPresetsKey) {
   args.presets = presets;
   args.presets_given = true;
   args.preset = "tiny";
-  LaserOdometryOptions options;
-  std::vector<std::string> warnings;
-  bool found = true;
-  std::string error;
-  ASSERT_TRUE(loadEvaluateOptions(args, &options, &warnings, &found, &error)) << error;
-  EXPECT_EQ(options.preset, "tiny");
-  EXPECT_EQ(options.tracker.matcher.genetic.population, 12);
+  const Loaded tiny = load(args);
+  ASSERT_TRUE(tiny.ok) << tiny.error;
+  EXPECT_EQ(tiny.options.preset, "tiny");
+  EXPECT_EQ(tiny.options.tracker.matcher.genetic.population, 12);
   std::remove(presets.c_str());
 }
 
