@@ -5,59 +5,84 @@
 
 namespace hglasm {
 
-LocalMap::LocalMap(const LocalMapOptions& options) : options_(options) {
+LocalMap::LocalMap(const LocalMapOptions& options, const std::vector<LookupTableOptions>& tables)
+    : options_(options), table_options_(tables) {
   options_.keyframes = std::max(1, options_.keyframes);
 }
 
 void LocalMap::add(const Pose2D& laser_pose, const std::vector<Eigen::Vector2d>& points) {
-  keyframes_.push_back(Keyframe{laser_pose, points});
-  while (keyframes_.size() > static_cast<std::size_t>(options_.keyframes)) keyframes_.pop_front();
-  while (keyframes_.size() > 1 &&
-         (keyframes_.front().laser_pose.translation() - laser_pose.translation()).norm() >
-             options_.max_distance) {
-    keyframes_.pop_front();
+  ++revision_;
+  frame_ = laser_pose;
+  // A new submap starts when the newer one is full; the older (matched) one goes when a third would start.
+  if (submaps_.empty() || submaps_.back().keyframes >= options_.keyframes) {
+    if (submaps_.size() >= 2) submaps_.pop_front();
+    submaps_.emplace_back();
+    Submap& started = submaps_.back();
+    started.anchor = laser_pose;
+    for (const LookupTableOptions& table : table_options_) started.tables.emplace_back(table);
   }
-  rebuild();
+  for (Submap& submap : submaps_) insert(&submap, laser_pose, points);
+  while (submaps_.size() > 1 &&
+         (submaps_.front().anchor.translation() - laser_pose.translation()).norm() > options_.max_distance) {
+    submaps_.pop_front();
+  }
+  refresh();
 }
 
 void LocalMap::clear() {
-  keyframes_.clear();
+  submaps_.clear();
   reference_.clear();
   frame_ = Pose2D();
   ++revision_;
 }
 
-void LocalMap::rebuild() {
-  ++revision_;
-  reference_.clear();
-  cells_.clear();
-  if (keyframes_.empty()) return;
-  frame_ = keyframes_.back().laser_pose;
-  const Pose2D to_frame = frame_.inverse();
-  // Oldest first: where keyframes overlap, the oldest view stays, so the map holds its shape while the
-  // robot moves through it instead of following the newest keyframe's error.
-  for (const Keyframe& keyframe : keyframes_) {
-    const Pose2D pose = to_frame * keyframe.laser_pose;
-    // A keyframe is never thinned by its own points (its beams keep their spacing), only by other keyframes'.
-    const std::size_t first = reference_.size();
-    const std::vector<Eigen::Vector2d>& points = keyframe.points;
-    covered_.assign(points.size(), 0);
-    if (options_.resolution > 0.0) {
-      for (std::size_t i = 0; i < points.size(); ++i) covered_[i] = covered(pose * points[i]);
-    }
-    // A kept point keeps its neighbouring beams too, covered or not: the surface it lies on stays a surface
-    // (alone, a thinned wall's survivors would be isolated points, precise along their beams, which along
-    // a corridor's wall is the direction nothing observes).
-    kept_.clear();
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const bool neighbour_kept = (i > 0 && !covered_[i - 1]) || (i + 1 < points.size() && !covered_[i + 1]);
-      if (!covered_[i] || neighbour_kept) kept_.push_back(points[i]);
-    }
-    reference_.append(kept_, pose);
-    if (options_.resolution > 0.0) {
-      for (std::size_t i = first; i < reference_.size(); ++i) remember(reference_.points[i]);
+const LookupTable& LocalMap::table(std::size_t index) const {
+  if (submaps_.empty() || index >= submaps_.front().tables.size()) return empty_table_;
+  return submaps_.front().tables[index];
+}
+
+void LocalMap::insert(Submap* submap, const Pose2D& laser_pose, const std::vector<Eigen::Vector2d>& points) {
+  const Pose2D pose = submap->anchor.inverse() * laser_pose;
+  // A keyframe is never thinned by its own points (its beams keep their spacing), only by older ones':
+  // where keyframes overlap the oldest view stays, so the map holds its shape while the robot moves
+  // through it instead of following the newest keyframe's error.
+  covered_.assign(points.size(), 0);
+  if (options_.resolution > 0.0) {
+    for (std::size_t i = 0; i < points.size(); ++i) covered_[i] = covered(*submap, pose * points[i]);
+  }
+  // A kept point keeps its neighbouring beams too, covered or not: the surface it lies on stays a surface
+  // (alone, a thinned wall's survivors would be isolated points, precise along their beams, which along a
+  // corridor's wall is the direction nothing observes).
+  kept_.clear();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const bool neighbour_kept = (i > 0 && !covered_[i - 1]) || (i + 1 < points.size() && !covered_[i + 1]);
+    if (!covered_[i] || neighbour_kept) kept_.push_back(points[i]);
+  }
+  added_.clear();
+  added_.append(kept_, pose);
+  submap->points.append(kept_, pose);
+  if (options_.resolution > 0.0) {
+    for (const Eigen::Vector2d& point : added_.points) {
+      if (point.allFinite()) submap->cells[cellKey(point, 0, 0)].push_back(point);
     }
   }
+  for (LookupTable& table : submap->tables) table.insert(added_);
+  ++submap->keyframes;
+}
+
+void LocalMap::refresh() {
+  reference_.clear();
+  if (submaps_.empty()) return;
+  Submap& matched = submaps_.front();
+  const Pose2D to_frame = frame_.inverse() * matched.anchor;
+  const ReferencePoints& points = matched.points;
+  reference_.points.reserve(points.size());
+  for (const Eigen::Vector2d& point : points.points) reference_.points.push_back(to_frame * point);
+  reference_.scan_starts = points.scan_starts;
+  for (const Eigen::Vector2d& origin : points.scan_origins)
+    reference_.scan_origins.push_back(to_frame * origin);
+  const Pose2D query_in_table = to_frame.inverse();
+  for (LookupTable& table : matched.tables) table.setQueryFrame(query_in_table);
 }
 
 std::uint64_t LocalMap::cellKey(const Eigen::Vector2d& point, int dx, int dy) const {
@@ -68,13 +93,13 @@ std::uint64_t LocalMap::cellKey(const Eigen::Vector2d& point, int dx, int dy) co
   return (static_cast<std::uint64_t>(cx) << 32) ^ (static_cast<std::uint64_t>(cy) & 0xffffffffu);
 }
 
-bool LocalMap::covered(const Eigen::Vector2d& point) const {
+bool LocalMap::covered(const Submap& submap, const Eigen::Vector2d& point) const {
   if (!point.allFinite() || std::abs(point.x()) > 1e6 || std::abs(point.y()) > 1e6) return true;
   const double limit_sq = options_.resolution * options_.resolution;
   for (int dx = -1; dx <= 1; ++dx) {
     for (int dy = -1; dy <= 1; ++dy) {
-      const auto it = cells_.find(cellKey(point, dx, dy));
-      if (it == cells_.end()) continue;
+      const auto it = submap.cells.find(cellKey(point, dx, dy));
+      if (it == submap.cells.end()) continue;
       for (const auto& other : it->second) {
         if ((other - point).squaredNorm() < limit_sq) return true;
       }
@@ -82,7 +107,5 @@ bool LocalMap::covered(const Eigen::Vector2d& point) const {
   }
   return false;
 }
-
-void LocalMap::remember(const Eigen::Vector2d& point) { cells_[cellKey(point, 0, 0)].push_back(point); }
 
 }  // namespace hglasm

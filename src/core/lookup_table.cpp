@@ -109,46 +109,79 @@ void LookupTable::collectSamples(const ReferencePoints& reference_set) {
   if (options_.isolated_footprint > 0.0) stampFootprints(reference_set, joins, spacing);
 }
 
-void LookupTable::build(const ReferencePoints& reference_set) {
-  const std::vector<Eigen::Vector2d>& reference = reference_set.points;
+void LookupTable::clear() {
   tiles_in_use_ = 0;
   tiles_x_ = tiles_y_ = 0;
+  origin_cell_x_ = origin_cell_y_ = 0;
   tile_index_.clear();
+  tile_cells_.clear();
+  stamped_.clear();
+}
 
-  // Global cell coordinates of the usable reference points, and their bounding box.
+void LookupTable::build(const ReferencePoints& reference_set) {
+  clear();
+  insert(reference_set);
+}
+
+namespace {
+
+/// The tile holding global cell `cell` (floor division by the tile size).
+long tileOf(long cell, int shift) {
+  const long size = 1L << shift;
+  return cell >= 0 ? cell >> shift : -((-cell + size - 1) >> shift);
+}
+
+}  // namespace
+
+void LookupTable::growGrid(long min_cx, long max_cx, long min_cy, long max_cy) {
+  long first_x = tileOf(min_cx, kTileShift), last_x = tileOf(max_cx, kTileShift);
+  long first_y = tileOf(min_cy, kTileShift), last_y = tileOf(max_cy, kTileShift);
+  const long old_first_x = origin_cell_x_ / kTileSize, old_first_y = origin_cell_y_ / kTileSize;
+  if (tiles_x_ > 0) {
+    if (first_x >= old_first_x && last_x < old_first_x + tiles_x_ && first_y >= old_first_y &&
+        last_y < old_first_y + tiles_y_) {
+      return;  // the grid already covers them
+    }
+    first_x = std::min(first_x, old_first_x), last_x = std::max(last_x, old_first_x + tiles_x_ - 1);
+    first_y = std::min(first_y, old_first_y), last_y = std::max(last_y, old_first_y + tiles_y_ - 1);
+  }
+  const long tiles_x = last_x - first_x + 1, tiles_y = last_y - first_y + 1;
+  std::vector<std::int32_t> index(static_cast<std::size_t>(tiles_x * tiles_y), -1);
+  for (long ty = 0; ty < tiles_y_; ++ty) {
+    std::copy_n(&tile_index_[ty * tiles_x_], tiles_x_,
+                &index[(ty + old_first_y - first_y) * tiles_x + (old_first_x - first_x)]);
+  }
+  tile_index_.swap(index);
+  tiles_x_ = tiles_x;
+  tiles_y_ = tiles_y;
+  origin_cell_x_ = first_x * kTileSize;
+  origin_cell_y_ = first_y * kTileSize;
+}
+
+void LookupTable::insert(const ReferencePoints& reference_set) {
+  // Global cell coordinates of the usable stamp centres, and their bounding box.
   long min_cx = 0, max_cx = -1, min_cy = 0, max_cy = -1;
-  std::vector<std::pair<long, long>> cells;
-  cells.reserve(reference.size());
+  cells_.clear();
   collectSamples(reference_set);
   for (const auto& p : samples_) {
     if (std::abs(p.x()) > kMaxCoordinate || std::abs(p.y()) > kMaxCoordinate) continue;
     const long cx = static_cast<long>(std::floor(p.x() * inv_cell_size_));
     const long cy = static_cast<long>(std::floor(p.y() * inv_cell_size_));
-    if (cells.empty()) {
+    if (cells_.empty()) {
       min_cx = max_cx = cx;
       min_cy = max_cy = cy;
     } else {
       min_cx = std::min(min_cx, cx), max_cx = std::max(max_cx, cx);
       min_cy = std::min(min_cy, cy), max_cy = std::max(max_cy, cy);
     }
-    cells.emplace_back(cx, cy);
+    cells_.emplace_back(cx, cy);
   }
-  if (cells.empty()) return;
+  if (cells_.empty()) return;
 
   // Tile grid covering the box grown by the kernel radius; only touched tiles get cells.
   const long r = kernel_radius_;
-  const auto floor_div = [](long a) {
-    return a >= 0 ? a >> kTileShift : -((-a + kTileSize - 1) >> kTileShift);
-  };
-  const long first_tile_x = floor_div(min_cx - r), last_tile_x = floor_div(max_cx + r);
-  const long first_tile_y = floor_div(min_cy - r), last_tile_y = floor_div(max_cy + r);
-  tiles_x_ = last_tile_x - first_tile_x + 1;
-  tiles_y_ = last_tile_y - first_tile_y + 1;
-  origin_cell_x_ = first_tile_x * kTileSize;
-  origin_cell_y_ = first_tile_y * kTileSize;
-  tile_index_.assign(static_cast<std::size_t>(tiles_x_ * tiles_y_), -1);
-
-  for (const auto& cell : cells) {
+  growGrid(min_cx - r, max_cx + r, min_cy - r, max_cy + r);
+  for (const auto& cell : cells_) {
     const long lx0 = cell.first - r - origin_cell_x_, lx1 = cell.first + r - origin_cell_x_;
     const long ly0 = cell.second - r - origin_cell_y_, ly1 = cell.second + r - origin_cell_y_;
     for (long ty = ly0 >> kTileShift; ty <= (ly1 >> kTileShift); ++ty) {
@@ -158,14 +191,18 @@ void LookupTable::build(const ReferencePoints& reference_set) {
       }
     }
   }
-  tile_cells_.assign(tiles_in_use_ * kTileCells, 0);
+  tile_cells_.resize(tiles_in_use_ * kTileCells, 0);
+  stamped_.resize(tiles_in_use_ * kTileCells, 0);
+  stampCells();
+}
 
-  // Stamp the kernel around each point, keeping the maximum (likelihood of the nearest point). A stamp
+void LookupTable::stampCells() {
+  // Stamp the kernel around each centre, keeping the maximum (likelihood of the nearest point). A stamp
   // depends on the centre's cell only: overlapping keyframes and close samples put many in one cell, which
-  // is stamped once.
-  stamped_.assign(tiles_in_use_ * kTileCells, 0);
+  // is stamped once, and stamping in any order gives the same table.
+  const long r = kernel_radius_;
   const long side = 2 * r + 1;
-  for (const auto& cell : cells) {
+  for (const auto& cell : cells_) {
     const long cx = cell.first - origin_cell_x_, cy = cell.second - origin_cell_y_;
     std::uint8_t& centre =
         stamped_[static_cast<std::size_t>(tile_index_[(cy >> kTileShift) * tiles_x_ + (cx >> kTileShift)]) *
@@ -198,8 +235,9 @@ void LookupTable::build(const ReferencePoints& reference_set) {
   }
 }
 
-std::uint8_t LookupTable::valueAt(const Eigen::Vector2d& point) const {
+std::uint8_t LookupTable::valueAt(const Eigen::Vector2d& query_point) const {
   if (tiles_in_use_ == 0) return 0;
+  const Eigen::Vector2d point = query_in_table_ * query_point;
   const double fx = point.x() * inv_cell_size_ - origin_cell_x_;
   const double fy = point.y() * inv_cell_size_ - origin_cell_y_;
   if (!(fx >= 0.0 && fy >= 0.0 && fx < tiles_x_ * kTileSize && fy < tiles_y_ * kTileSize)) return 0;

@@ -436,6 +436,17 @@ bool Mbicp::solveStep(const Pose2D& pose, bool settled, std::size_t min_associat
     a *= weight;
     b *= weight;
     const Eigen::Matrix3d g = incrementToPose(pose);
+    if (scan_noise_scale_ != ScanNoiseScale::Ones()) {
+      // The noise scale divides the information along its directions in the pose's own coordinates
+      // (I = F^T a F, F = G^-1); the same map on a and b keeps the scan's own minimum.
+      const Eigen::Matrix3d f = g.inverse();
+      const InformationDirections directions = informationDirections(f.transpose() * a * f);
+      const Eigen::Matrix3d map =
+          g.transpose() * scaledInformationMap(directions, scan_noise_scale_) * f.transpose();
+      a = map * a;
+      a = 0.5 * (a + a.transpose());
+      b = map * b;
+    }
     const Eigen::Vector3d offset(pose.x - prior->mean.x, pose.y - prior->mean.y,
                                  normalizeAngle(pose.theta - prior->mean.theta));
     a += g.transpose() * prior->information * g;
@@ -492,7 +503,10 @@ void Mbicp::estimateUncertainty(const PosePrior* prior, MbicpResult* result) con
   const Eigen::Matrix3d from_pose = to_pose.inverse();
   // What the MAP weighed the scan with (the metric's normal equations of the last iteration): a posterior
   // built from it below is the one the iterations converged to.
-  result->scan_information = from_pose.transpose() * scan_information_ * from_pose;
+  const Eigen::Matrix3d stated = from_pose.transpose() * scan_information_ * from_pose;
+  result->scan_directions = informationDirections(stated);
+  result->scan_information = scaledInformationMap(result->scan_directions, scan_noise_scale_) * stated;
+  result->scan_information = 0.5 * (result->scan_information + result->scan_information.transpose());
   if (prior) {
     const Eigen::Matrix3d posterior = result->scan_information + prior->information;
     result->covariance = clampEigenvalues(posterior.inverse(), kMinVariance, kMaxVariance);

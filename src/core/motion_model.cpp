@@ -8,11 +8,6 @@ namespace {
 
 double square(double value) { return value * value; }
 
-// A sample may raise the sums by at most this many times what the current model expects, so one bad
-// match (a door swinging) does not teach the model that the wheels are bad.
-constexpr double kMaxNormalisedSample = 16.0;
-constexpr double kPriorSamples = 10.0;
-
 }  // namespace
 
 MotionNoiseModel::MotionNoiseModel(const MotionNoiseOptions& options) : options_(options) {}
@@ -35,7 +30,13 @@ Eigen::Matrix3d MotionNoiseModel::odometryCovariance(const Pose2D& increment, do
   Eigen::Matrix3d covariance = nominalOdometryCovariance(increment, dt);
   covariance.topLeftCorner<2, 2>() *= scale_.xy;
   covariance(2, 2) *= scale_.theta;
-  return covariance;
+  return covariance + systematicCovariance(increment);
+}
+
+Eigen::Matrix3d MotionNoiseModel::systematicCovariance(const Pose2D& increment) const {
+  const double xy = square(options_.systematic * increment.translationNorm());
+  const double theta = square(options_.systematic * increment.theta);
+  return Eigen::Vector3d(xy, xy, theta).asDiagonal();
 }
 
 Eigen::Matrix3d MotionNoiseModel::constantVelocityCovariance(double dt) const {
@@ -48,35 +49,6 @@ Eigen::Matrix3d MotionNoiseModel::constantVelocityCovariance(double dt) const {
                                         square(0.5 * options_.constant_velocity_theta * step_sq),
                                     1e-12);
   return Eigen::Vector3d(var_xy, var_xy, var_theta).asDiagonal();
-}
-
-void MotionNoiseModel::resetLearning() {
-  scale_ = MotionNoiseScale();
-  xy_excess_ = xy_nominal_ = theta_excess_ = theta_nominal_ = 0.0;
-}
-
-void MotionNoiseModel::learn(const Eigen::Vector3d& innovation, const Eigen::Vector3d& explained,
-                             const Eigen::Vector3d& nominal) {
-  if (!options_.learn || !innovation.allFinite() || !explained.allFinite() || !nominal.allFinite()) return;
-  const double forget = std::exp2(-1.0 / std::max(1.0, options_.learn_half_life));
-  const auto update = [&](double innovation_sq, double explained_var, double nominal_var, double* excess,
-                          double* nominal_sum, double* scale) {
-    if (!(nominal_var > 0.0)) return;
-    if (*nominal_sum == 0.0) {
-      // Start from the configured model as if it had been seen kPriorSamples times: the first few matches
-      // alone would set the scale anywhere.
-      *nominal_sum = kPriorSamples * nominal_var;
-      *excess = *scale * *nominal_sum;
-    }
-    const double expected = explained_var + *scale * nominal_var;
-    const double sample = std::min(innovation_sq, kMaxNormalisedSample * expected);
-    *excess = forget * *excess + (sample - explained_var);
-    *nominal_sum = forget * *nominal_sum + nominal_var;
-    *scale = std::clamp(*excess / *nominal_sum, options_.min_scale, options_.max_scale);
-  };
-  update(innovation.head<2>().squaredNorm(), explained.x() + explained.y(), nominal.x() + nominal.y(),
-         &xy_excess_, &xy_nominal_, &scale_.xy);
-  update(square(innovation.z()), explained.z(), nominal.z(), &theta_excess_, &theta_nominal_, &scale_.theta);
 }
 
 }  // namespace hglasm

@@ -74,8 +74,11 @@ double OdometryBuffer::largestTurnRate(double from, double to) const {
 
 double OdometryBuffer::newestStamp() const { return samples_.empty() ? 0.0 : samples_.back().stamp; }
 
-bool OdometryBuffer::poseAt(double stamp, double max_extrapolation, Pose2D* pose) const {
+bool OdometryBuffer::poseAt(double stamp, double max_extrapolation, Pose2D* pose, double* outside) const {
   if (samples_.empty() || !std::isfinite(stamp)) return false;
+  if (outside) {
+    *outside = std::max({0.0, samples_.front().stamp - stamp, stamp - samples_.back().stamp});
+  }
   // Before the buffered span hold the oldest sample (for at most max_extrapolation seconds).
   if (stamp <= samples_.front().stamp) {
     if (samples_.front().stamp - stamp > max_extrapolation) return false;

@@ -13,7 +13,7 @@ namespace hglasm {
 namespace {
 
 constexpr double kMaxVariance = kUnknownVariance;
-constexpr int kMinFitnessHistory = 20;     // matches before the usual fit is known
+constexpr int kMinFitnessHistory = 5;      // matches before the usual fit is known
 constexpr double kFitnessHalfLife = 50.0;  // matches
 // Variance of the rotation between where two consecutive scans alone put the base (rad^2): two matches
 // against the same map share most of their error; (2 mrad)^2 leaves room for a keyframe change between.
@@ -107,6 +107,20 @@ bool matcherHasGradedTable(Algorithm algorithm) {
   return algorithm == Algorithm::kHglasmG || algorithm == Algorithm::kGlasmG;
 }
 
+/// The lookup tables the local map keeps for the matcher: the GA's fine and coarse table (of the
+/// algorithm's kind), then the graded table scans are judged on if the fine one is not it.
+std::vector<LookupTableOptions> mapTables(const MatcherOptions& matcher) {
+  const bool lookup_ga = usesGeneticStage(matcher.algorithm) && !usesPolarPairing(matcher.algorithm);
+  const TableKind kind =
+      matcherHasGradedTable(matcher.algorithm) || !lookup_ga ? TableKind::kGraded : TableKind::kBinary;
+  LookupTableOptions fine = matcher.table, coarse = matcher.coarse_table, graded = matcher.table;
+  fine.kind = coarse.kind = kind;
+  graded.kind = TableKind::kGraded;
+  if (!lookup_ga) return {graded};
+  if (kind == TableKind::kGraded) return {fine, coarse};
+  return {fine, coarse, graded};
+}
+
 double millisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -120,15 +134,12 @@ OdometryTracker::OdometryTracker(const TrackerOptions& options)
                     options.max_odometry_turn_rate, options.use_imu, options.imu),
       keyframes_(options.keyframe),
       noise_(options.motion),
+      noise_learner_(options.noise_learning),
+      calibration_(options.wheel_calibration),
       gyro_bias_(options.imu),
       time_offset_(options.odometry_time_offset),
-      local_map_(options.local_map) {
+      local_map_(options.local_map, mapTables(options.matcher)) {
   extrapolator_.setOdometryTimeOffset(time_offset_.offset());
-  if (!matcherHasGradedTable(options_.matcher.algorithm)) {
-    LookupTableOptions graded = options_.matcher.table;
-    graded.kind = TableKind::kGraded;
-    own_table_.emplace(graded);
-  }
 }
 
 void OdometryTracker::setLaserMount(const Pose2D& base_to_laser) {
@@ -149,6 +160,8 @@ void OdometryTracker::reset() {
   prediction_wrong_ = 0.0;
   fitness_ = RunningStats();
   have_scan_only_pose_ = have_scan_rotation_ = false;
+  noise_learner_.breakChain();
+  unexplained_scans_ = 0;
   set_pose_stamp_.reset();
 }
 
@@ -220,15 +233,17 @@ OdometryTracker::Candidate OdometryTracker::evaluate(const Scan& scan, const Mat
   return candidate;
 }
 
+bool OdometryTracker::fitsAsUsual(double fitness_ratio) const {
+  return fitness_.count < kMinFitnessHistory ||
+         fitness_ratio >= fitness_.mean - options_.max_mahalanobis * std::sqrt(fitness_.variance);
+}
+
 bool OdometryTracker::predictionInDoubt(const Candidate& tight, const PosePrior& prior,
                                         const Eigen::Matrix3d& prior_covariance) const {
   const double gate_sq = options_.max_mahalanobis * options_.max_mahalanobis;
   if (!tight.acceptable || tight.mahalanobis_sq > gate_sq) return true;
   // The scan fits the map far worse than scans usually do: the pose near the prediction is not its place.
-  if (fitness_.count >= kMinFitnessHistory &&
-      tight.fitness_ratio < fitness_.mean - options_.max_mahalanobis * std::sqrt(fitness_.variance)) {
-    return true;
-  }
+  if (!fitsAsUsual(tight.fitness_ratio)) return true;
   // The innovation test: where the scan alone would put the pose, against the prediction, with both
   // uncertainties (directions the scan does not constrain carry no innovation).
   const Eigen::Vector3d innovation = poseDifference(tight.match.scan_only_pose, prior.mean);
@@ -246,16 +261,21 @@ bool OdometryTracker::predictionInDoubt(const Candidate& tight, const PosePrior&
   return !(innovation_sq <= gate_sq);
 }
 
-double OdometryTracker::scanLogLikelihood(const Scan& scan, const Pose2D& pose) const {
-  // The scan's likelihood counts its independent points only, as its information does.
+double OdometryTracker::likelihoodWeight(const Scan& scan) const {
+  // The scan's likelihood counts its independent points only, as its information does, and is tempered
+  // by as much as the learned noise says the scan overstates its information.
   const double independent = options_.matcher.mbicp.independent_points;
   const double weight =
       independent > 0.0 ? std::min(1.0, independent / std::max<double>(1.0, scan.size())) : 1.0;
+  return weight / noise_learner_.scanEvidenceScale();
+}
+
+double OdometryTracker::scanLogLikelihood(const Scan& scan, const Pose2D& pose) const {
   const LookupTable& table = judgingTable();
   if (table.empty() || scan.empty()) return 0.0;
   FitnessPoints points;
   points.assign(scan.points);
-  return weight * table.logLikelihood(points, pose, options_.likelihood_outlier);
+  return likelihoodWeight(scan) * table.logLikelihood(points, pose, options_.likelihood_outlier);
 }
 
 double OdometryTracker::freeSpaceLogLikelihood(const Scan& scan, const Pose2D& pose) const {
@@ -263,11 +283,8 @@ double OdometryTracker::freeSpaceLogLikelihood(const Scan& scan, const Pose2D& p
   // beam through the wall is not. Each such beam costs what an outlier point does.
   const LookupTable& table = judgingTable();
   if (table.empty() || scan.empty() || options_.likelihood_outlier <= 0.0) return 0.0;
-  const double independent = options_.matcher.mbicp.independent_points;
-  const double weight =
-      independent > 0.0 ? std::min(1.0, independent / std::max<double>(1.0, scan.size())) : 1.0;
   const int through = table.beamsThroughSurfaces(scan.points, pose, 3.0 * table.options().sigma);
-  return weight * through * std::log(options_.likelihood_outlier);
+  return likelihoodWeight(scan) * through * std::log(options_.likelihood_outlier);
 }
 
 double OdometryTracker::fitnessRatioAt(const Scan& scan, const Pose2D& pose) const {
@@ -340,6 +357,14 @@ void OdometryTracker::scoreHypotheses(const Scan& scan, const Hypotheses& h, con
            std::log(h.wrong_probability);
 }
 
+double OdometryTracker::predictionScore(const Scan& scan, const Hypotheses& h) const {
+  // Nothing near the prediction fits: the alternative to a leap is the prediction itself with a scan that
+  // says little there (an occluded or changed view), not nothing. Its posterior volume is the prior's.
+  const double log_volume = 0.5 * std::log(std::max((2.0 * M_PI * h.covariance).determinant(), 1e-300));
+  return scanLogLikelihood(scan, h.prior.mean) + freeSpaceLogLikelihood(scan, h.prior.mean) +
+         logPrior(h.prior.mean, h.prior, h.covariance) + log_volume + std::log1p(-h.wrong_probability);
+}
+
 void OdometryTracker::testLeap(const Scan& scan, const Hypotheses& h, std::vector<Pose2D>* population_out,
                                Candidate* chosen, TrackerUpdate* update) {
   double holds = 0.0, wrong = 0.0;
@@ -363,7 +388,7 @@ void OdometryTracker::testLeap(const Scan& scan, const Hypotheses& h, std::vecto
   // people fits the map better turned onto another corridor, with beams through its walls.
   const double stay_score = chosen->acceptable
                                 ? std::max(holds, wrong) + freeSpaceLogLikelihood(scan, chosen->match.pose)
-                                : -HUGE_VAL;
+                                : predictionScore(scan, h);
   double leap_holds = -HUGE_VAL, leap_wrong = -HUGE_VAL;
   if (leap.acceptable) {
     scoreHypotheses(scan, h, leap.match, &leap_holds, &leap_wrong);
@@ -373,7 +398,8 @@ void OdometryTracker::testLeap(const Scan& scan, const Hypotheses& h, std::vecto
   }
   const bool leap_is_far = leap.mahalanobis_sq > options_.max_mahalanobis * options_.max_mahalanobis;
   Candidate* loser = &leap;
-  if (std::max(leap_holds, leap_wrong) > stay_score) {
+  const double leap_score = std::max(leap_holds, leap_wrong);
+  if (leap_score > stay_score) {
     std::swap(*chosen, leap);
     update->leap = leap_is_far;
     update->search = h.wide_search;
@@ -418,6 +444,8 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   update->leap_probability = prediction_wrong_;
   update->match = chosen.match;
   update->prior_mahalanobis = std::sqrt(chosen.mahalanobis_sq);
+  update->degeneracy = chosen.match.scan_directions.degeneracy();
+  update->weakest_direction = chosen.match.scan_directions.weakestDirection();
   if (population_out) {
     for (auto& pose : *population_out) pose = fromMap(pose);
   }
@@ -431,23 +459,64 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   return true;
 }
 
+void OdometryTracker::learnCalibration(const MotionPrediction& prediction, const Pose2D& scan_motion,
+                                       const Eigen::Matrix3d& scan_covariance) {
+  // The step's innovation variance: the wheels' noise and both scans' (heading; along the track, the
+  // larger translation variance of each: the direction of travel is unknown here).
+  const Eigen::Matrix3d scans = scan_covariance + scan_only_covariance_;
+  const double heading_variance = prediction.covariance(2, 2) + scans(2, 2);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> translation(
+      prediction.covariance.topLeftCorner<2, 2>() + scans.topLeftCorner<2, 2>());
+  // An IMU gave the rotation: the wheels' turn says nothing about their heading errors.
+  calibration_.learn(prediction.wheel_motion, scan_motion, prediction.gyro ? -1.0 : heading_variance,
+                     translation.eigenvalues().maxCoeff());
+  extrapolator_.setWheelCalibration(calibration_);
+}
+
+NoiseSample OdometryTracker::noiseSample(const MotionPrediction& prediction, const MatchResult& match,
+                                         const Pose2D& scan_only) const {
+  NoiseSample sample;
+  sample.scan_pose = scan_only;
+  const Eigen::Matrix3d to_base =
+      jacobianOf([this](const Pose2D& laser) { return fromMap(laser); }, match.scan_only_pose);
+  const auto parts = covarianceByDirection(match.scan_directions, kMaxVariance);
+  for (int j = 0; j < 3; ++j) sample.scan_covariance[j] = to_base * parts[j] * to_base.transpose();
+  sample.wheel_motion = prediction.motion;
+  // The nominal covariance's translation block scales with the wheels' translation noise, its heading
+  // with their heading noise (zero where an IMU gave the rotation); the rest (the IMU's) is known.
+  sample.wheel_xy = prediction.nominal_covariance;
+  sample.wheel_xy.row(2).setZero();
+  sample.wheel_xy.col(2).setZero();
+  sample.wheel_theta(2, 2) = prediction.nominal_covariance(2, 2);
+  sample.wheel_known =
+      prediction.covariance - noise_.scale().xy * sample.wheel_xy - noise_.scale().theta * sample.wheel_theta;
+  return sample;
+}
+
 void OdometryTracker::learnNoise(const MotionPrediction& prediction, const MatchResult& match,
                                  bool learn_wheels) {
   // Two consecutive scans matched against the same map share most of their error, so the motion between
-  // where the scans alone put them is a far better measurement of the increment than any wheels': what
-  // the wheels' increment differs from it by is (almost all) their noise.
+  // where the scans alone put them measures the increment; against the wheels' it shows both noises.
   const Pose2D scan_only = fromMap(match.scan_only_pose);
   const bool scan_usable = !match.degenerate && scan_only.isFinite();
   const bool usable = learn_wheels && prediction.source == PredictionSource::kOdometry && scan_usable;
-  if (scan_usable && have_scan_rotation_) {
+  Eigen::Matrix3d scan_covariance = Eigen::Matrix3d::Zero();
+  if (usable) {
+    if (!have_scan_only_pose_) noise_learner_.breakChain();
+    const NoiseSample sample = noiseSample(prediction, match, scan_only);
+    noise_learner_.add(sample);
+    noise_.setScale(noise_learner_.wheelScale());
+    matcher_.setScanNoiseScale(noise_learner_.scanScale());
+    for (const Eigen::Matrix3d& part : sample.scan_covariance) scan_covariance += part;
+    if (have_scan_only_pose_)
+      learnCalibration(prediction, relativePose(scan_only_pose_, scan_only), scan_covariance);
+  } else {
+    noise_learner_.breakChain();
+  }
+  scan_only_covariance_ = scan_covariance;
+  if (scan_usable && have_scan_rotation_ && prediction.gyro) {
     const Pose2D scan_motion = relativePose(scan_only_pose_, scan_only);
-    if (usable && have_scan_only_pose_) {
-      const Pose2D wheel_error = relativePose(prediction.motion, scan_motion);
-      noise_.learn(Eigen::Vector3d(wheel_error.x, wheel_error.y, wheel_error.theta), Eigen::Vector3d::Zero(),
-                   prediction.nominal_covariance.diagonal());
-    }
-    if (prediction.gyro &&
-        gyro_bias_.update(prediction.motion.theta, scan_motion.theta, kScanRotationVariance, prediction.dt,
+    if (gyro_bias_.update(prediction.motion.theta, scan_motion.theta, kScanRotationVariance, prediction.dt,
                           last_stamp_ + prediction.dt)) {
       extrapolator_.setGyroBias(gyro_bias_.bias(), gyro_bias_.variance());
     }
@@ -490,7 +559,13 @@ void OdometryTracker::learnTimeOffset(double stamp) {
   if (!time_offset_.update(extrapolator_.odometry())) return;
   extrapolator_.setOdometryTimeOffset(time_offset_.offset());
   // The wheels' noise was learned from predictions read at the wrong time: it was mostly the offset's.
-  if (std::abs(time_offset_.offset() - before) >= TimeOffsetEstimator::kMinOffset) noise_.resetLearning();
+  if (std::abs(time_offset_.offset() - before) >= TimeOffsetEstimator::kMinOffset) {
+    noise_learner_.reset();
+    calibration_.reset();
+    extrapolator_.setWheelCalibration(calibration_);
+    noise_.setScale(noise_learner_.wheelScale());
+    matcher_.setScanNoiseScale(noise_learner_.scanScale());
+  }
 }
 
 bool OdometryTracker::deskew(double stamp, const Scan& sensor_scan, Scan* compensated) const {
@@ -551,14 +626,13 @@ void OdometryTracker::updateVelocity(double stamp, const Pose2D& new_pose, Track
 void OdometryTracker::addKeyframe(const Scan& scan) {
   const bool had_map = !local_map_.empty();
   const Pose2D old_frame = local_map_.frame();
+  const auto start = std::chrono::steady_clock::now();
   local_map_.add(pose_ * laser_mount_, scan.points);
-  matcher_.setReference(local_map_.reference());
-  table_build_ms_ = matcher_.lastTableBuildMs();
-  if (own_table_) {
-    const auto start = std::chrono::steady_clock::now();
-    own_table_->build(local_map_.reference());
-    table_build_ms_ += millisecondsSince(start);
+  if (local_map_.tableCount() >= 2) {
+    matcher_.useTables(&local_map_.table(kFineTable), &local_map_.table(kCoarseTable));
   }
+  matcher_.setReference(local_map_.reference());
+  table_build_ms_ = millisecondsSince(start);
   // The pose's uncertainty relative to the map stays; only the frame it is expressed in turns.
   map_covariance_ = had_map ? rotateCovariance(relativePose(local_map_.frame(), old_frame), map_covariance_)
                             : Eigen::Matrix3d::Zero();
@@ -567,12 +641,20 @@ void OdometryTracker::addKeyframe(const Scan& scan) {
 }
 
 void OdometryTracker::updateKeyframe(const Scan& scan, bool usable, TrackerUpdate* update) {
-  if (!usable) return;  // a scan without geometry cannot become a keyframe
-  // A usable scan the map could not explain (the robot moved during a pause, the surroundings changed):
-  // the map no longer describes where the robot is, so it restarts from this scan, at the pose predicted.
-  if (update->fallback && !local_map_.empty()) {
+  // A scan without geometry cannot become a keyframe, nor one that leapt (the wheels may be right after
+  // all, and a keyframe at the leap would hold the map to it).
+  if (!usable || update->leap) return;
+  // A usable scan the map could not explain is an outlier (someone standing in front of the laser) and
+  // stays out of the map; a second one in a row says the map no longer describes where the robot is (it
+  // moved during a pause, the surroundings changed), so the map restarts from it, at the pose predicted.
+  const bool failed = update->fallback && !local_map_.empty();
+  const bool reanchor = failed && unexplained_scans_ >= 1;
+  unexplained_scans_ = failed ? unexplained_scans_ + 1 : 0;
+  if (failed && !reanchor) return;
+  if (reanchor) {
     local_map_.clear();
     update->reanchored = true;
+    unexplained_scans_ = 0;
   }
   if (local_map_.empty() ||
       keyframes_.wantsKeyframe(pose_, update->matched, update->fallback, update->fitness_ratio)) {
@@ -656,6 +738,10 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
   update.velocity = extrapolator_.velocity();
   update.keyframe_id = keyframe_id_;
   update.noise_scale = noise_.scale();
+  update.scan_noise_scale = noise_learner_.scanScale();
+  update.wheel_turn_scale = calibration_.turnScale();
+  update.wheel_heading_per_metre = calibration_.headingPerMetre();
+  update.wheel_distance_scale = calibration_.distanceScale();
   update.imu_bias = gyro_bias_.bias();
   return update;
 }

@@ -83,16 +83,23 @@ MotionPrediction PoseExtrapolator::predictTranslation(double from, double to, co
   const double dt = to - from;
   Pose2D odom_from, odom_to;
   const double shift = odometry_time_offset_;
-  if (use_odometry_ && odometry_.poseAt(from + shift, max_odometry_age_, &odom_from) &&
-      odometry_.poseAt(to + shift, max_odometry_age_, &odom_to)) {
+  double outside_from = 0.0, outside_to = 0.0;
+  if (use_odometry_ && odometry_.poseAt(from + shift, max_odometry_age_, &odom_from, &outside_from) &&
+      odometry_.poseAt(to + shift, max_odometry_age_, &odom_to, &outside_to)) {
     const Pose2D motion = relativePose(odom_from, odom_to);
     const bool plausible =
         motion.translationNorm() <= max_speed_ * dt + kJitterMargin && plausibleTurn(motion.theta, dt);
     if (plausible) {
       prediction.source = PredictionSource::kOdometry;
-      prediction.motion = motion;
-      prediction.covariance = noise.odometryCovariance(motion, dt);
-      prediction.nominal_covariance = noise.nominalOdometryCovariance(motion, dt);
+      prediction.wheel_motion = motion;
+      prediction.motion = calibration_.correct(motion);
+      prediction.covariance = noise.odometryCovariance(prediction.motion, dt);
+      prediction.nominal_covariance = noise.nominalOdometryCovariance(prediction.motion, dt);
+      // Where the samples do not reach (held before the first, extrapolated after the last) the wheels'
+      // motion is a guess at constant velocity, as uncertain as one.
+      if (outside_from + outside_to > 0.0) {
+        prediction.covariance += noise.constantVelocityCovariance(outside_from + outside_to);
+      }
       return prediction;
     }
     std::ostringstream text;

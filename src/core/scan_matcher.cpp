@@ -154,7 +154,7 @@ void ScanMatcher::setReference(const ReferencePoints& reference) {
   const auto start = std::chrono::steady_clock::now();
   if (usesPolarPairing(options_.algorithm)) {
     polar_pairing_.build(reference);  // PGA's preparation: sorting the reference by angle
-  } else if (usesGeneticStage(options_.algorithm)) {
+  } else if (usesGeneticStage(options_.algorithm) && !external_fine_) {
     table_.build(reference);
     reference_ = reference;
     coarse_table_stale_ = true;
@@ -190,7 +190,7 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
     const auto start = std::chrono::steady_clock::now();
     const int coarse_generations = effort ? effort->coarse_generations : options_.genetic.coarse_generations;
     const bool polar = usesPolarPairing(options_.algorithm);
-    if (!polar && coarse_generations > 0 && coarse_table_stale_) {
+    if (!polar && !external_coarse_ && coarse_generations > 0 && coarse_table_stale_) {
       coarse_table_.build(reference_);
       coarse_table_stale_ = false;
       coarse_table_build_ms_ = millisecondsSince(start);
@@ -201,7 +201,8 @@ MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vecto
       const FitnessStages stages = polarPairingStages(polar_pairing_, pga_points_, options_.table.cell_size);
       prealigned = aligner_.align(stages, start_pose, population_out, effort);
     } else {
-      prealigned = aligner_.align(table_, scan.points, start_pose, population_out, &coarse_table_, effort);
+      prealigned =
+          aligner_.align(fineTable(), scan.points, start_pose, population_out, &coarseTable(), effort);
     }
     result.prealign_ms = millisecondsSince(start);
     result.prealigned_pose = result.pose = prealigned.pose;
@@ -232,6 +233,7 @@ void ScanMatcher::refineInto(const Scan& scan, const PosePrior* prior, MatchResu
   result->mbicp_status = refined.status;
   result->covariance = refined.covariance;
   result->scan_information = refined.scan_information;
+  result->scan_directions = refined.scan_directions;
   result->degenerate = refined.degenerate;
   result->scan_only_pose = refined.scan_only_pose;
   switch (refined.status) {
@@ -256,16 +258,17 @@ MatchResult ScanMatcher::refine(const Scan& scan, const Pose2D& guess, const Pos
 }
 
 double ScanMatcher::fitnessRatioAt(const Scan& scan, const Pose2D& pose) const {
-  if (table_.empty() || scan.empty()) return 0.0;
-  const double best = static_cast<double>(table_.maxCellValue()) * static_cast<double>(scan.size());
-  return table_.fitness(scan.points, pose) / best;
+  const LookupTable& table = fineTable();
+  if (table.empty() || scan.empty()) return 0.0;
+  const double best = static_cast<double>(table.maxCellValue()) * static_cast<double>(scan.size());
+  return table.fitness(scan.points, pose) / best;
 }
 
 double ScanMatcher::logLikelihoodAt(const Scan& scan, const Pose2D& pose, double outlier) const {
-  if (table_.empty() || scan.empty()) return 0.0;
+  if (fineTable().empty() || scan.empty()) return 0.0;
   FitnessPoints points;
   points.assign(scan.points);
-  return table_.logLikelihood(points, pose, outlier);
+  return fineTable().logLikelihood(points, pose, outlier);
 }
 
 }  // namespace hglasm

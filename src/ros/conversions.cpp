@@ -54,6 +54,11 @@ void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
   match->prior_mahalanobis = finiteFloat(update.prior_mahalanobis);
   match->noise_scale_xy = finiteFloat(update.noise_scale.xy);
   match->noise_scale_theta = finiteFloat(update.noise_scale.theta);
+  match->degeneracy = finiteFloat(update.degeneracy);
+  match->weakest_direction.x = finiteFloat(update.weakest_direction.x());
+  match->weakest_direction.y = finiteFloat(update.weakest_direction.y());
+  match->weakest_direction.theta = finiteFloat(update.weakest_direction.z());
+  for (int j = 0; j < 3; ++j) match->scan_noise_scale[j] = finiteFloat(update.scan_noise_scale[j]);
   match->deskewed = update.deskewed;
   match->mbicp_status = toMsg(update.match.mbicp_status);
   match->matched = update.matched;

@@ -471,6 +471,11 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
   input_counts_ = pipeline_.inputCounts();
   time_offset_ = update.odometry_time_offset;
   time_offset_estimate_ = update.odometry_time_offset_estimate;
+  if (update.matched) {
+    degeneracy_ = update.degeneracy;
+    weakest_direction_ = update.weakest_direction;
+  }
+  noise_scale_ = update.noise_scale;
   if (update.stale) return;  // not processed: not a scan of the rate or failure statistics
   ++scans_processed_;
   if (update.fallback) ++fallbacks_;
@@ -596,6 +601,12 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
     status.add("odometry time offset, estimate (s)", time_offset_estimate_);
     status.add("odometry time offset", options_.tracker.odometry_time_offset.estimate ? "learned" : "fixed");
   }
+  status.add("degeneracy of the last match (min / max information)", degeneracy_);
+  status.add("weakest direction of the last match (x, y, theta)",
+             std::to_string(weakest_direction_.x()) + ", " + std::to_string(weakest_direction_.y()) + ", " +
+                 std::to_string(weakest_direction_.z()));
+  status.add("wheel noise scale learned (xy, theta)",
+             std::to_string(noise_scale_.xy) + ", " + std::to_string(noise_scale_.theta));
   status.add("queued scans", queued);
   status.add("preset", options_.preset);
   if (options_.tracker.use_imu)

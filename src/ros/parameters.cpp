@@ -360,10 +360,23 @@ void visitPredictionOptions(Params& tree, LaserOdometryOptions* options) {
   tree.nonNegativeNumber("odometry/noise/theta_per_metre", &motion.theta_per_metre);
   tree.nonNegativeNumber("odometry/noise/theta_per_radian", &motion.theta_per_radian);
   tree.nonNegativeNumber("odometry/noise/theta_per_second", &motion.theta_per_second);
-  tree.boolean("odometry/noise/learn", &motion.learn);
-  tree.positiveNumber("odometry/noise/learn_half_life", &motion.learn_half_life);
-  tree.positiveNumber("odometry/noise/min_scale", &motion.min_scale);
-  tree.positiveNumber("odometry/noise/max_scale", &motion.max_scale);
+  tree.nonNegativeNumber("odometry/noise/systematic", &motion.systematic);
+  hglasm::NoiseLearnerOptions& learning = tracker.noise_learning;
+  tree.boolean("odometry/noise/learn", &learning.learn_wheels);
+  tree.positiveNumber("odometry/noise/learn_half_life", &learning.half_life);
+  tree.positiveInteger("odometry/noise/learn_lags", &learning.lags);
+  tree.positiveNumber("odometry/noise/min_scale", &learning.min_wheel_scale);
+  tree.positiveNumber("odometry/noise/max_scale", &learning.max_wheel_scale);
+  hglasm::WheelCalibrationOptions& calibration = tracker.wheel_calibration;
+  tree.boolean("odometry/calibration/learn", &calibration.learn);
+  tree.positiveNumber("odometry/calibration/half_life", &calibration.half_life);
+  tree.positiveNumber("odometry/calibration/heading_per_metre", &calibration.heading_per_metre);
+  tree.positiveNumber("odometry/calibration/turn_scale", &calibration.turn_scale);
+  tree.positiveNumber("odometry/calibration/distance_scale", &calibration.distance_scale);
+  tree.boolean("scan_noise/learn", &learning.learn_scan);
+  tree.boolean("scan_noise/directional", &learning.directional);
+  tree.positiveNumber("scan_noise/min_scale", &learning.min_scan_scale);
+  tree.positiveNumber("scan_noise/max_scale", &learning.max_scan_scale);
   tree.positiveNumber("constant_velocity/xy", &motion.constant_velocity_xy);
   tree.positiveNumber("constant_velocity/theta", &motion.constant_velocity_theta);
   tree.nonNegativeNumber("constant_velocity/velocity_xy", &motion.constant_velocity_velocity_xy);
@@ -493,10 +506,14 @@ bool checkConsistency(const LaserOdometryOptions& options, std::string* error) {
     return fail("parameter ~genetic/tournament_size must not exceed ~genetic/population (" +
                 std::to_string(genetic.population) + "), got " + std::to_string(genetic.tournament_size));
   }
-  const hglasm::MotionNoiseOptions& motion = options.tracker.motion;
-  if (motion.max_scale < motion.min_scale) {
+  const hglasm::NoiseLearnerOptions& learning = options.tracker.noise_learning;
+  if (learning.max_wheel_scale < learning.min_wheel_scale) {
     return fail("parameter ~odometry/noise/max_scale must be at least ~odometry/noise/min_scale (" +
-                formatNumber(motion.min_scale) + "), got " + formatNumber(motion.max_scale));
+                formatNumber(learning.min_wheel_scale) + "), got " + formatNumber(learning.max_wheel_scale));
+  }
+  if (learning.max_scan_scale < learning.min_scan_scale) {
+    return fail("parameter ~scan_noise/max_scale must be at least ~scan_noise/min_scale (" +
+                formatNumber(learning.min_scan_scale) + "), got " + formatNumber(learning.max_scan_scale));
   }
   const hglasm::ScanConversionOptions& conversion = options.tracker.conversion;
   if (conversion.max_range <= conversion.min_range) {

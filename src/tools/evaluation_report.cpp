@@ -72,13 +72,19 @@ void printFusion(std::FILE* out, const EvaluationRun& run) {
       map_keyframes += update.map_keyframes;
     }
   }
-  const hglasm::MotionNoiseScale noise =
-      run.updates.empty() ? hglasm::MotionNoiseScale() : run.updates.back().noise_scale;
+  const hglasm::TrackerUpdate last = run.updates.empty() ? hglasm::TrackerUpdate() : run.updates.back();
   std::fprintf(out,
                "\nfusion        prediction doubted %d times: %d leaps taken, %d rejected; %d of %d searches "
-               "small-sized, %.1f keyframes per map; wheel noise scale learned: xy %.3g, theta %.3g",
+               "small-sized, %.1f keyframes per map; wheel noise scale learned: xy %.3g, theta %.3g; scan "
+               "noise scale (weakest, middle, strongest direction) %.3g, %.3g, %.3g",
                doubted, leaps, rejected, small_searches, run.matched,
-               run.matched ? map_keyframes / run.matched : 0.0, noise.xy, noise.theta);
+               run.matched ? map_keyframes / run.matched : 0.0, last.noise_scale.xy, last.noise_scale.theta,
+               last.scan_noise_scale[0], last.scan_noise_scale[1], last.scan_noise_scale[2]);
+  std::fprintf(
+      out,
+      "\nwheels        systematic errors learned: turn scale %+.4f, heading %+.3f deg/m, distance scale "
+      "%+.4f",
+      last.wheel_turn_scale, last.wheel_heading_per_metre * 180.0 / M_PI, last.wheel_distance_scale);
 }
 
 /// CPU (and wall) time per stage: median, p99, max and the mean per scan.

@@ -1,4 +1,5 @@
-// The local map: the last keyframes at their poses, in the newest keyframe's frame.
+// The local map: two overlapping submaps of the last keyframes at their poses, offered in the newest
+// keyframe's frame, and their lookup tables grown keyframe by keyframe.
 #include "hglasm_odometry/core/local_map.h"
 
 #include <gtest/gtest.h>
@@ -21,40 +22,83 @@ std::vector<Eigen::Vector2d> wall(double distance, double half_length = 1.0, dou
   return points;
 }
 
-TEST(LocalMap, KeepsTheLastKeyframesAndExpressesThemInTheNewestFrame) {
+TEST(LocalMap, TwoOverlappingSubmapsHoldTheLastKeyframesInTheNewestFrame) {
+  // Three keyframes per submap: a new submap starts when the newer one holds three, and the older one goes
+  // then, so the matched submap holds between four and six keyframes once the map is running.
   LocalMapOptions options;
   options.keyframes = 3;
   options.resolution = 0.0;
   LocalMap map(options);
   EXPECT_TRUE(map.empty());
-  for (int k = 0; k < 5; ++k) map.add(Pose2D(1.0 * k, 0.0, 0.1 * k), {Eigen::Vector2d(2.0, 0.0)});
-  ASSERT_EQ(map.keyframeCount(), 3u);
-  EXPECT_NEAR(map.frame().x, 4.0, 1e-12);
-  EXPECT_NEAR(map.frame().theta, 0.4, 1e-12);
-  // Oldest first: keyframes 2, 3, 4, each point 2 m ahead of its keyframe, seen from keyframe 4.
+  const std::vector<std::size_t> expected_count = {1, 2, 3, 4, 5, 6, 4, 5, 6, 4};
+  for (int k = 0; k < 10; ++k) {
+    map.add(Pose2D(1.0 * k, 0.0, 0.1 * k), {Eigen::Vector2d(2.0, 0.0)});
+    EXPECT_EQ(map.keyframeCount(), expected_count[k]) << "after keyframe " << k;
+  }
+  EXPECT_NEAR(map.frame().x, 9.0, 1e-12);
+  EXPECT_NEAR(map.frame().theta, 0.9, 1e-12);
+  // Oldest first: keyframes 6 to 9, each point 2 m ahead of its keyframe, seen from keyframe 9.
   const hglasm::ReferencePoints& reference = map.reference();
-  ASSERT_EQ(reference.size(), 3u);
-  EXPECT_EQ(reference.scan_starts, (std::vector<std::size_t>{0, 1, 2}));
-  for (int k = 2; k <= 4; ++k) {
+  ASSERT_EQ(reference.size(), 4u);
+  EXPECT_EQ(reference.scan_starts, (std::vector<std::size_t>{0, 1, 2, 3}));
+  for (int k = 6; k <= 9; ++k) {
     const Eigen::Vector2d expected =
         map.frame().inverse() * (Pose2D(1.0 * k, 0.0, 0.1 * k) * Eigen::Vector2d(2.0, 0.0));
-    EXPECT_NEAR((reference.points[k - 2] - expected).norm(), 0.0, 1e-12) << "keyframe " << k;
+    EXPECT_NEAR((reference.points[k - 6] - expected).norm(), 0.0, 1e-12) << "keyframe " << k;
+    const Eigen::Vector2d origin = map.frame().inverse() * Pose2D(1.0 * k, 0.0, 0.1 * k).translation();
+    EXPECT_NEAR((reference.scanOrigin(k - 6) - origin).norm(), 0.0, 1e-12) << "keyframe " << k;
   }
-  EXPECT_NEAR((reference.points[2] - Eigen::Vector2d(2.0, 0.0)).norm(), 0.0, 1e-12)
+  EXPECT_NEAR((reference.points[3] - Eigen::Vector2d(2.0, 0.0)).norm(), 0.0, 1e-12)
       << "the newest keyframe's points are its own";
   map.clear();
   EXPECT_TRUE(map.empty());
   EXPECT_TRUE(map.reference().empty());
 }
 
-TEST(LocalMap, KeyframesTooFarFromTheNewestLeave) {
+TEST(LocalMap, ASubmapTooFarFromTheNewestKeyframeLeaves) {
   LocalMapOptions options;
-  options.keyframes = 10;
+  options.keyframes = 4;
   options.max_distance = 2.5;
   options.resolution = 0.0;
   LocalMap map(options);
   for (int k = 0; k < 6; ++k) map.add(Pose2D(1.0 * k, 0.0, 0.0), wall(3.0));
-  EXPECT_EQ(map.keyframeCount(), 3u) << "keyframes 3, 4 and 5 are within 2.5 m of keyframe 5";
+  // Keyframes 0-3 started the first submap, 4 the second; at keyframe 5 the first starts 5 m away.
+  EXPECT_EQ(map.keyframeCount(), 2u) << "the submap of keyframes 4 and 5";
+  map.add(Pose2D(6.0, 0.0, 0.0), wall(3.0));
+  EXPECT_EQ(map.keyframeCount(), 3u) << "the newer submap goes only once a third would start";
+}
+
+TEST(LocalMap, ItsTablesGrowKeyframeByKeyframeAndAnswerInTheNewestFrame) {
+  // The submap's table in its first keyframe's frame, grown by inserts, against a table built at once from
+  // the reference the map offers in the newest frame: the same values at every probed point.
+  LocalMapOptions options;
+  options.keyframes = 50;
+  hglasm::LookupTableOptions table;
+  LocalMap map(options, {table});
+  for (int k = 0; k < 8; ++k) {
+    map.add(Pose2D(0.4 * k, 0.1 * std::sin(k), 0.05 * k), wall(3.0, 2.0, 0.05));
+  }
+  hglasm::LookupTable built(table);
+  built.build(map.reference());
+  ASSERT_FALSE(map.table(0).empty());
+  int probed = 0, mismatched = 0;
+  for (double x = -1.0; x <= 5.0; x += 0.037) {
+    for (double y = -3.0; y <= 3.0; y += 0.041) {
+      const int a = map.table(0).valueAt(Eigen::Vector2d(x, y)), b = built.valueAt(Eigen::Vector2d(x, y));
+      // Cells of the two tables are rotated against each other: a value may differ by up to about two cells'
+      // worth of the kernel's slope (4 cm cells, sigma 10 cm: up to ~60 per cell).
+      mismatched += std::abs(a - b) > 130;
+      ++probed;
+    }
+  }
+  EXPECT_LT(mismatched, probed / 1000) << mismatched << " of " << probed;
+  // A scan on the wall scores the same on both (the fitness is read in the newest keyframe's frame).
+  hglasm::FitnessPoints points;
+  points.assign(wall(3.0, 2.0, 0.1));
+  const double fitness = map.table(0).fitness(points, Pose2D());
+  EXPECT_NEAR(fitness / built.fitness(points, Pose2D()), 1.0, 0.05);
+  EXPECT_GT(fitness, 0.8 * 255.0 * points.size());
+  EXPECT_TRUE(map.table(1).empty()) << "no such table";
 }
 
 TEST(LocalMap, OverlappingViewsAddNothingButAKeyframeKeepsAllItsOwnPoints) {

@@ -287,6 +287,60 @@ TEST(LookupTable, RebuildReplacesTheOldReference) {
   EXPECT_EQ(table.valueAt({10.0, -3.0}), 0);
 }
 
+TEST(LookupTable, InsertingScanByScanGivesTheTableBuiltAtOnce) {
+  // Three scans far apart and overlapping, in an order that grows the tile grid to every side: inserted
+  // one by one, the table is cell for cell the one built from all three.
+  LookupTableOptions options;  // joined surfaces and footprints included
+  hglasm::ReferencePoints all, first, second, third;
+  const auto scan = [](double x0, double y0, double heading) {
+    std::vector<Eigen::Vector2d> points;
+    for (int i = 0; i < 60; ++i) {
+      const double angle = heading - 0.8 + 0.027 * i;
+      const double range = 2.0 + 0.3 * std::sin(0.4 * i);
+      points.emplace_back(x0 + range * std::cos(angle), y0 + range * std::sin(angle));
+    }
+    return points;
+  };
+  first.append(scan(5.0, 5.0, 0.3));
+  second.append(scan(-4.0, -6.0, 2.0));
+  third.append(scan(4.5, 4.0, -1.0));
+  for (const auto* part : {&first, &second, &third}) all.append(part->points);
+  LookupTable built(options), inserted(options);
+  built.build(all);
+  for (const auto* part : {&first, &second, &third}) inserted.insert(*part);
+  int compared = 0;
+  for (double x = -9.0; x <= 10.0; x += 0.013) {
+    for (double y = -11.0; y <= 10.0; y += 0.017) {
+      ASSERT_EQ(inserted.valueAt({x, y}), built.valueAt({x, y})) << x << ", " << y;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 1000000);
+  EXPECT_EQ(inserted.tileCount(), built.tileCount());
+  inserted.clear();
+  EXPECT_TRUE(inserted.empty());
+  EXPECT_EQ(inserted.valueAt({5.0, 5.0}), 0);
+}
+
+TEST(LookupTable, AQueryFrameMovesEveryQueryIntoTheTable) {
+  // A table in a fixed frame asked in another: the query frame's pose in the table's frame is applied to
+  // every pose and point handed in.
+  LookupTable table(gradedOptions());
+  table.build({kCentre});
+  const hglasm::Pose2D query_in_table(1.0, -2.0, 0.7);
+  table.setQueryFrame(query_in_table);
+  const Eigen::Vector2d in_query = query_in_table.inverse() * kCentre;
+  EXPECT_EQ(table.valueAt(in_query), 255);
+  EXPECT_EQ(table.valueAt(kCentre), 0);
+  hglasm::FitnessPoints point;
+  point.assign({Eigen::Vector2d::Zero()});
+  const hglasm::Pose2D at_centre(in_query.x(), in_query.y(), 0.3);
+  EXPECT_EQ(table.fitness(point, at_centre), 255u);
+  EXPECT_EQ(table.beamsThroughSurfaces({Eigen::Vector2d(1.0, 0.0)},
+                                       hglasm::Pose2D(in_query.x() - 0.5, in_query.y(), 0.0), 0.05),
+            1);
+}
+
 TEST(LookupTable, OtherCellSizesAndSigmas) {
   LookupTableOptions options = gradedOptions();
   options.cell_size = 0.01;

@@ -184,6 +184,9 @@ TEST(Parameters, FusionLocalMapAndNoiseParametersAreValidated) {
   EXPECT_NE(loadError(params({{"odometry/noise/min_scale", 2.0}, {"odometry/noise/max_scale", 1.0}}))
                 .find("~odometry/noise/max_scale must be at least ~odometry/noise/min_scale"),
             std::string::npos);
+  EXPECT_NE(loadError(params({{"scan_noise/min_scale", 2.0}, {"scan_noise/max_scale", 1.0}}))
+                .find("~scan_noise/max_scale must be at least ~scan_noise/min_scale"),
+            std::string::npos);
   EXPECT_NE(loadError(params({{"covariance/unexplained_xy", "big"}})).find("~covariance/unexplained_xy"),
             std::string::npos);
   EXPECT_NE(loadError(params({{"fusion", 1}})).find("~fusion must be true or false"), std::string::npos);
@@ -199,6 +202,13 @@ TEST(Parameters, FusionLocalMapAndNoiseParametersAreRead) {
                                   {"local_map/resolution", 0.05},
                                   {"leap/probability", 0.01},
                                   {"odometry/noise/learn", false},
+                                  {"odometry/noise/learn_lags", 3},
+                                  {"odometry/noise/systematic", 0.02},
+                                  {"odometry/calibration/learn", true},
+                                  {"odometry/calibration/turn_scale", 0.2},
+                                  {"scan_noise/learn", true},
+                                  {"scan_noise/directional", false},
+                                  {"scan_noise/min_scale", 0.5},
                                   {"odometry/noise/theta_per_radian", 0.2},
                                   {"constant_velocity/xy", 2.0},
                                   {"covariance/unexplained_theta", 0.01},
@@ -210,7 +220,14 @@ TEST(Parameters, FusionLocalMapAndNoiseParametersAreRead) {
   EXPECT_EQ(t.local_map.keyframes, 3);
   EXPECT_EQ(t.local_map.resolution, 0.05);
   EXPECT_EQ(t.leap_probability, 0.01);
-  EXPECT_FALSE(t.motion.learn);
+  EXPECT_FALSE(t.noise_learning.learn_wheels);
+  EXPECT_EQ(t.noise_learning.lags, 3);
+  EXPECT_EQ(t.motion.systematic, 0.02);
+  EXPECT_TRUE(t.wheel_calibration.learn);
+  EXPECT_EQ(t.wheel_calibration.turn_scale, 0.2);
+  EXPECT_TRUE(t.noise_learning.learn_scan);
+  EXPECT_FALSE(t.noise_learning.directional);
+  EXPECT_EQ(t.noise_learning.min_scan_scale, 0.5);
   EXPECT_EQ(t.motion.theta_per_radian, 0.2);
   EXPECT_EQ(t.motion.constant_velocity_xy, 2.0);
   EXPECT_EQ(t.unexplained_theta, 0.01);

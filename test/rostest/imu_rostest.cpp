@@ -177,7 +177,7 @@ void report(const char* what, const Instance& entry) {
               entry.imu_bias);
 }
 
-TEST(ImuRos, FastTurnsAreTrackedWithTheImuAndLostByTheSlippingWheels) {
+TEST(ImuRos, FastTurnsAreTrackedWithTheImuAndOnlyLeapByLeapWithTheSlippingWheels) {
   ImuScene& s = *scene;
   ASSERT_TRUE(waitFor([&] { return s.connected(); }, 20.0)) << "the three nodelets did not connect";
   s.sendTf();
@@ -196,7 +196,9 @@ TEST(ImuRos, FastTurnsAreTrackedWithTheImuAndLostByTheSlippingWheels) {
   }
   EXPECT_NEAR(s.g.imu_bias, kImuBias, 0.01) << "/odo_g publishes the bias it learned on ~match";
   EXPECT_EQ(s.w.rotations_from_imu, 0);
-  EXPECT_GT(s.w.worst_rotation, deg(10.0)) << "the wheels alone were expected to lose the spins";
+  // The wheels alone miss 70 % of every spin: only leaps (each needing the scan's evidence to outweigh the
+  // odds against it) keep that nodelet on track, at nearly every spin.
+  EXPECT_GE(s.w.leaps, 5) << "the wheels alone were expected to need a leap at the spins";
 }
 
 TEST(ImuRos, AStalledImuFallsBackToTheWheelsWithOneWarningAndIsTakenBackWhenItReturns) {

@@ -1,4 +1,5 @@
-// The reference scans are matched against: the last keyframes, placed at their estimated poses.
+// The reference scans are matched against: the keyframes of a submap, placed at their estimated poses,
+// with the submap's lookup tables grown keyframe by keyframe.
 #pragma once
 
 #include <Eigen/Core>
@@ -8,66 +9,83 @@
 #include <unordered_map>
 #include <vector>
 
+#include "hglasm_odometry/core/lookup_table.h"
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
 
 namespace hglasm {
 
 struct LocalMapOptions {
-  /// Keyframes in the map (1: match against the last keyframe only). More keyframes hold a scan's match to
-  /// more of the surroundings, so each keyframe's own error adds up less (at low scan rates every scan is a
-  /// keyframe); they cost association time.
-  int keyframes = 7;
-  /// Metres: a keyframe this far from the newest one leaves the map (what the robot no longer sees).
+  /// Keyframes per submap. Two submaps overlap (as Cartographer's): every keyframe goes into both, a new one
+  /// starts when the newer holds this many, and the older (the one scans are matched against) is then
+  /// dropped, so a scan meets between this many and twice as many keyframes. More keyframes hold the match
+  /// to more of the surroundings, so each keyframe's own error adds up less; 1: the last keyframe only.
+  int keyframes = 20;
+  /// Metres: a submap whose first keyframe is this far from the newest keyframe is dropped (what the robot
+  /// no longer sees), once a newer one holds a keyframe.
   double max_distance = 20.0;
-  /// Metres: a point this close to a point of an older keyframe adds nothing and is left out, so the map
-  /// costs what the surfaces it holds cost, not what the number of keyframes does, and where keyframes
-  /// overlap the scan is matched to the oldest view (the anchor that drifted least). 0 keeps every point.
+  /// Metres: a point this close to a point of an older keyframe of the submap adds nothing and is left out,
+  /// so the map costs what the surfaces it holds cost, not what the number of keyframes does, and where
+  /// keyframes overlap the scan is matched to the oldest view (the anchor that drifted least). 0 keeps
+  /// every point.
   double resolution = 0.03;
 };
 
-/// Keyframes (points in their laser frame, laser pose in the odometry frame) and their union in the
-/// newest keyframe's frame, rebuilt when a keyframe comes or goes. Not thread-safe per instance.
+/// Keyframes (points in their laser frame, laser pose in the odometry frame) gathered into submaps, each in
+/// its first keyframe's frame with its lookup tables; the matched submap's points are offered in the newest
+/// keyframe's frame too (MbICP's reference, whose metric wants the sensor near the origin). Not thread-safe
+/// per instance.
 class LocalMap {
  public:
-  explicit LocalMap(const LocalMapOptions& options = {});
+  /// `tables`: the lookup tables every submap keeps (e.g. the GA's fine and coarse tables), grown by each
+  /// keyframe; they answer queries in frame() (LookupTable::setQueryFrame).
+  explicit LocalMap(const LocalMapOptions& options = {}, const std::vector<LookupTableOptions>& tables = {});
 
-  /// Adds a keyframe: `points` in the laser frame, `laser_pose` in the odometry frame. Drops the oldest
-  /// keyframes beyond the options' count or distance.
+  /// Adds a keyframe: `points` in the laser frame, `laser_pose` in the odometry frame.
   void add(const Pose2D& laser_pose, const std::vector<Eigen::Vector2d>& points);
   void clear();
 
-  bool empty() const { return keyframes_.empty(); }
-  std::size_t keyframeCount() const { return keyframes_.size(); }
+  bool empty() const { return submaps_.empty(); }
+  /// Keyframes of the submap scans are matched against.
+  std::size_t keyframeCount() const { return submaps_.empty() ? 0 : submaps_.front().keyframes; }
   /// The newest keyframe's laser pose in the odometry frame: the frame reference() is expressed in.
   const Pose2D& frame() const { return frame_; }
-  /// Every keyframe's points in frame(), one scan per keyframe.
+  /// The matched submap's points in frame(), one scan per keyframe.
   const ReferencePoints& reference() const { return reference_; }
+  /// Lookup table `index` (as given to the constructor) of the matched submap, answering in frame().
+  const LookupTable& table(std::size_t index) const;
+  std::size_t tableCount() const { return table_options_.size(); }
   const LocalMapOptions& options() const { return options_; }
   /// Changes whenever reference() or frame() may have changed (every add() and clear()): consumers that
   /// copy the map (its display) compare it with the revision they copied.
   std::uint64_t revision() const { return revision_; }
 
  private:
-  struct Keyframe {
-    Pose2D laser_pose;
-    std::vector<Eigen::Vector2d> points;
+  struct Submap {
+    Pose2D anchor;           // laser pose of its first keyframe, odometry frame: the frame of points
+    ReferencePoints points;  // kept points of its keyframes, one scan per keyframe
+    std::vector<LookupTable> tables;
+    std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> cells;  // kept points by grid cell
+    int keyframes = 0;
   };
-  void rebuild();
-  /// True if a point of a keyframe added before lies within options_.resolution of `point`.
-  bool covered(const Eigen::Vector2d& point) const;
-  void remember(const Eigen::Vector2d& point);
+  /// Adds a keyframe's points (in the submap's frame as `pose`) but for those an older keyframe holds.
+  void insert(Submap* submap, const Pose2D& laser_pose, const std::vector<Eigen::Vector2d>& points);
+  /// True if a point of the submap lies within options_.resolution of `point`.
+  bool covered(const Submap& submap, const Eigen::Vector2d& point) const;
   std::uint64_t cellKey(const Eigen::Vector2d& point, int dx, int dy) const;
+  /// reference() and the tables' query frame after the matched submap or frame() changed.
+  void refresh();
 
   LocalMapOptions options_;
-  std::deque<Keyframe> keyframes_;  // oldest first
+  std::vector<LookupTableOptions> table_options_;
+  std::deque<Submap> submaps_;  // oldest (matched) first, at most two
   Pose2D frame_;
   ReferencePoints reference_;
   std::uint64_t revision_ = 0;
-  // Scratch of rebuild(): kept points by grid cell (cell side = resolution).
-  std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> cells_;
-  std::vector<Eigen::Vector2d> kept_;  // in the keyframe's frame
-  std::vector<std::uint8_t> covered_;  // per point of the keyframe being added: an older keyframe has it
+  LookupTable empty_table_;
+  ReferencePoints added_;              // scratch: the keyframe's kept points as one scan
+  std::vector<Eigen::Vector2d> kept_;  // scratch: in the keyframe's frame
+  std::vector<std::uint8_t> covered_;  // scratch: per point of the keyframe, an older keyframe has it
 };
 
 }  // namespace hglasm

@@ -60,6 +60,14 @@ class LookupTable {
   void build(const std::vector<Eigen::Vector2d>& reference);
   /// The same for several scans in one frame (a local map): gaps are joined within a scan only.
   void build(const ReferencePoints& reference);
+  /// Adds reference scans (in the table's own frame) to what it holds, stamping only them: a local map that
+  /// grows keyframe by keyframe. Cells keep the maximum, so any order of inserts gives build()'s table.
+  void insert(const ReferencePoints& scans);
+  void clear();
+  /// The queries below take poses and points in a frame whose pose in the table's own frame is
+  /// `query_in_table` (identity by default): a table kept in a fixed frame serves a moving reference frame.
+  void setQueryFrame(const Pose2D& query_in_table) { query_in_table_ = query_in_table; }
+  const Pose2D& queryFrame() const { return query_in_table_; }
 
   /// Log-likelihood of `points` moved by `pose` under the table read as a likelihood field: each point
   /// scores log(outlier + cell / maxCell), a normal of its distance to the reference mixed with a uniform
@@ -100,6 +108,10 @@ class LookupTable {
     return std::abs(p.x()) <= kMaxCoordinate && std::abs(p.y()) <= kMaxCoordinate;  // false for NaN
   }
   void buildKernel();
+  /// Widens the tile grid (keeping the tiles it has) to cover global cells [min, max] on both axes.
+  void growGrid(long min_cx, long max_cx, long min_cy, long max_cy);
+  /// Stamps the kernel around every centre of cells_ not stamped before.
+  void stampCells();
   /// Stamp centres (samples_): the points, samples along joined gaps and isolated points' footprints.
   void collectSamples(const ReferencePoints& reference);
   /// Adds samples across the beam of each isolated reference point (isolated_footprint).
@@ -111,8 +123,9 @@ class LookupTable {
   /// in blocks the compiler vectorises; coordinates are clamped to [-1, size] first (NaN -> -1), so the
   /// integer conversion is always defined and one unsigned comparison per axis is the bounds check.
   template <typename F>
-  void forEachCell(const FitnessPoints& points, const Pose2D& pose, F&& f) const {
-    if (tiles_in_use_ == 0 || !pose.isFinite()) return;
+  void forEachCell(const FitnessPoints& points, const Pose2D& query_pose, F&& f) const {
+    if (tiles_in_use_ == 0 || !query_pose.isFinite()) return;
+    const Pose2D pose = query_in_table_ * query_pose;
     const float c = static_cast<float>(std::cos(pose.theta) * inv_cell_size_);
     const float s = static_cast<float>(std::sin(pose.theta) * inv_cell_size_);
     const float ox = static_cast<float>(pose.x * inv_cell_size_ - origin_cell_x_);
@@ -157,7 +170,9 @@ class LookupTable {
   std::vector<std::int32_t> tile_index_;  // tiles_x_ * tiles_y_, -1 = no tile
   std::vector<std::uint8_t> tile_cells_;  // tiles_in_use_ * kTileCells
   std::size_t tiles_in_use_ = 0;
+  Pose2D query_in_table_;
   std::vector<Eigen::Vector2d> samples_;             // scratch: stamp centres
+  std::vector<std::pair<long, long>> cells_;         // scratch: their global cells
   std::vector<std::uint8_t> stamped_;                // scratch: 1 where a stamp is centred (as tile_cells_)
   std::vector<std::uint8_t> kernel_;                 // (2r+1)^2 stamp, r = ceil(cutoff / cell_size)
   std::vector<std::pair<long, long>> kernel_spans_;  // per kernel row: [first, last) non-zero columns

@@ -7,6 +7,7 @@
 
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
+#include "hglasm_odometry/core/scan_information.h"
 
 namespace hglasm {
 
@@ -76,9 +77,12 @@ struct MbicpResult {
   /// Eigenvalues are clamped to [1e-8, 1e4]: always finite and positive definite. With a prior, the
   /// covariance of the posterior (scan and prior).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
-  /// Information of the scan alone about (x, y, theta) at the final pose, calibrated (independent_points);
-  /// singular along directions the scene does not constrain (a corridor's axis).
+  /// Information of the scan alone about (x, y, theta) at the final pose, calibrated (independent_points)
+  /// and divided by the scan's noise scale direction by direction (setScanNoiseScale); singular along
+  /// directions the scene does not constrain (a corridor's axis).
   Eigen::Matrix3d scan_information = Eigen::Matrix3d::Zero();
+  /// The eigen-directions of that information before the noise scale: what the scene constrains.
+  InformationDirections scan_directions;
   /// With a prior: where the scan alone would have put the pose (one scan-only step from the last
   /// iterate, on the final associations); equal to `pose` without a prior.
   Pose2D scan_only_pose;
@@ -103,6 +107,10 @@ class Mbicp {
   MbicpResult match(const Scan& scan, const Pose2D& initial, const PosePrior* prior = nullptr);
 
   const MbicpOptions& options() const { return options_; }
+
+  /// How far the scan's information is to be believed, direction by direction (learned by the caller):
+  /// divides it along its eigen-directions in the MAP and in the result. (1, 1, 1) by default.
+  void setScanNoiseScale(const ScanNoiseScale& scale) { scan_noise_scale_ = scale; }
 
  private:
   struct Association {
@@ -163,7 +171,8 @@ class Mbicp {
   std::vector<int> sorted_index_;              // their indices into ref_points_
   std::vector<Association> associations_;      // scratch
   Eigen::Matrix3d scan_information_ = Eigen::Matrix3d::Zero();  // of the last step, increment coordinates
-  std::vector<Eigen::Vector2d> moved_;                          // scratch
+  ScanNoiseScale scan_noise_scale_ = ScanNoiseScale::Ones();
+  std::vector<Eigen::Vector2d> moved_;  // scratch
 };
 
 }  // namespace hglasm

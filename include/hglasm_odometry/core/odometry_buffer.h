@@ -25,8 +25,9 @@ class OdometryBuffer {
   /// Pose at `stamp`, interpolated between the two samples around it. After the newest sample it
   /// extrapolates with the velocity over the last 0.05-1 s of samples (holds the newest sample if there is
   /// no such baseline), before the oldest it holds the oldest; at most `max_extrapolation` seconds, else
-  /// false.
-  bool poseAt(double stamp, double max_extrapolation, Pose2D* pose) const;
+  /// false. `outside` (optional) receives the seconds from `stamp` to the nearest sample when it lies
+  /// outside the samples (what they do not cover), else 0.
+  bool poseAt(double stamp, double max_extrapolation, Pose2D* pose, double* outside = nullptr) const;
 
   /// The longest time between consecutive samples over [from, to] (the samples around either end
   /// included): how finely the buffer knows the motion there. Infinity where it does not cover the span.

@@ -11,6 +11,7 @@
 #include "hglasm_odometry/core/keyframe_policy.h"
 #include "hglasm_odometry/core/local_map.h"
 #include "hglasm_odometry/core/motion_model.h"
+#include "hglasm_odometry/core/noise_learner.h"
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/pose_extrapolator.h"
 #include "hglasm_odometry/core/scan.h"
@@ -24,6 +25,10 @@ struct TrackerOptions {
   ScanConversionOptions conversion;  ///< applied by callers that convert RangeScans (ROS layer, tools)
   LocalMapOptions local_map;
   MotionNoiseOptions motion;
+  /// The wheels' noise and the scan's information are scaled by what the matches show (NoiseLearner).
+  NoiseLearnerOptions noise_learning;
+  /// The wheels' systematic errors, learned from the matches and removed from their motion.
+  WheelCalibrationOptions wheel_calibration;
   KeyframeOptions keyframe;
   double min_fitness = 0.15;                 ///< a match whose pose is below this fitness ratio has failed
   int min_points = 20;                       ///< scans with fewer valid points are not matched
@@ -124,6 +129,17 @@ struct TrackerUpdate {
   int keyframe_id = 0;
   int map_keyframes = 0;         ///< keyframes in the local map the scan was matched against
   MotionNoiseScale noise_scale;  ///< the wheel-noise scales learned so far
+  ScanNoiseScale scan_noise_scale = ScanNoiseScale::Ones();  ///< the scan's, weakest direction first
+  /// The wheels' systematic errors learned so far (WheelCalibration): removed from their motion.
+  double wheel_turn_scale = 0.0;
+  double wheel_heading_per_metre = 0.0;  ///< rad/m
+  double wheel_distance_scale = 0.0;
+  /// What the scene constrains: smallest / largest eigenvalue of the scan's information (x, y and theta
+  /// weighed as kDirectionLength metres per radian; 0: a direction the scan says nothing about, such as a
+  /// featureless corridor's axis) and that weakest direction (x, y, theta; laser in the local map's frame).
+  /// 0 and zero without a match.
+  double degeneracy = 0.0;
+  Eigen::Vector3d weakest_direction = Eigen::Vector3d::Zero();
   /// Seconds the wheels' stamps run late (their pose of the scan's instant was read this much later), and
   /// the best estimate so far (the offset in use until the evidence for it suffices).
   double odometry_time_offset = 0.0;
@@ -221,6 +237,9 @@ class OdometryTracker {
   /// log posterior of a match under each hypothesis (up to a common constant).
   void scoreHypotheses(const Scan& scan, const Hypotheses& h, const MatchResult& match, double* holds,
                        double* wrong) const;
+  /// log posterior of "the prediction holds" at the predicted pose itself (when no match near it is
+  /// acceptable).
+  double predictionScore(const Scan& scan, const Hypotheses& h) const;
   /// If the prediction is in doubt, searches the preset's box too and keeps the more probable match.
   void testLeap(const Scan& scan, const Hypotheses& h, std::vector<Pose2D>* population_out, Candidate* chosen,
                 TrackerUpdate* update);
@@ -234,6 +253,8 @@ class OdometryTracker {
                  TrackerUpdate* update, Estimate* estimate);
   SearchEffort searchEffort(const Eigen::Matrix3d& prior_covariance, bool have_prior) const;
   Candidate evaluate(const Scan& scan, const MatchResult& match, const PosePrior& prior) const;
+  /// Whether a match fits the map as well as matches usually do (within max_mahalanobis of their spread).
+  bool fitsAsUsual(double fitness_ratio) const;
   /// Whether the tight match (or the scan alone) disagrees with the prediction beyond its noise.
   bool predictionInDoubt(const Candidate& tight, const PosePrior& prior,
                          const Eigen::Matrix3d& prior_covariance) const;
@@ -244,15 +265,27 @@ class OdometryTracker {
   double freeSpaceLogLikelihood(const Scan& scan, const Pose2D& pose) const;
   /// The fitness ratio of `scan` at `pose` (local map's frame) on the judging table.
   double fitnessRatioAt(const Scan& scan, const Pose2D& pose) const;
-  /// The fine graded table of the local map that scans are judged on: the matcher's own where it is one
-  /// (hglasm_g, glasm_g), else own_table_ (binary tables, MbICP and PGA alone have none), so that one
-  /// yardstick judges every algorithm.
-  const LookupTable& judgingTable() const { return own_table_ ? *own_table_ : matcher_.table(); }
+  /// The fine graded table of the local map that scans are judged on: the GA's own where it is one (hglasm_g,
+  /// glasm_g), else a third table (binary tables; MbICP and PGA alone have only it), so that one yardstick
+  /// judges every algorithm (mapTables()).
+  const LookupTable& judgingTable() const {
+    return local_map_.table(local_map_.tableCount() == 3 ? 2 : kFineTable);
+  }
+  static constexpr std::size_t kFineTable = 0;  // the local map's tables (mapTables())
+  static constexpr std::size_t kCoarseTable = 1;
   /// log of the normal density of `pose` under a prior.
   static double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3d& covariance);
-  /// Learns the wheels' noise (if `learn_wheels`) and the gyro's bias from their increments against the
-  /// scans' own.
+  /// Learns the wheels' and the scan's noise (if `learn_wheels`: a leap is the wheels' outlier, not their
+  /// noise) and the gyro's bias from their increments against the scans' own.
   void learnNoise(const MotionPrediction& prediction, const MatchResult& match, bool learn_wheels);
+  /// The learner's sample of this scan: where it alone put the base, the wheels' motion since the last.
+  /// Learns the wheels' systematic errors from one step between two matched scans.
+  void learnCalibration(const MotionPrediction& prediction, const Pose2D& scan_motion,
+                        const Eigen::Matrix3d& scan_covariance);
+  NoiseSample noiseSample(const MotionPrediction& prediction, const MatchResult& match,
+                          const Pose2D& scan_only) const;
+  /// The scan likelihood's weight: its independent points, divided by how far the scan is believed.
+  double likelihoodWeight(const Scan& scan) const;
   Estimate integratePrediction(const MotionPrediction& prediction) const;
   void updateVelocity(double stamp, const Pose2D& new_pose, TrackerUpdate* update);
   void updateKeyframe(const Scan& scan, bool usable, TrackerUpdate* update);
@@ -263,11 +296,12 @@ class OdometryTracker {
 
   TrackerOptions options_;
   ScanMatcher matcher_;
-  std::optional<LookupTable> own_table_;  // see judgingTable()
-  double table_build_ms_ = 0.0;           // of the tables of the newest keyframe's map
+  double table_build_ms_ = 0.0;  // the newest keyframe into the map: its tables and MbICP's reference
   PoseExtrapolator extrapolator_;
   KeyframePolicy keyframes_;
   MotionNoiseModel noise_;
+  NoiseLearner noise_learner_;
+  WheelCalibration calibration_;
   GyroBiasEstimator gyro_bias_;
   TimeOffsetEstimator time_offset_;
   LocalMap local_map_;
@@ -287,12 +321,14 @@ class OdometryTracker {
     double variance = 0.0;
     void add(double value);
   };
-  RunningStats fitness_;              // of accepted matches: how well scans usually fit the map
-  Pose2D scan_only_pose_;             // base pose in the odometry frame where the last scan alone put it
+  RunningStats fitness_;   // of accepted matches: how well scans usually fit the map
+  Pose2D scan_only_pose_;  // base pose in the odometry frame where the last scan alone put it
+  Eigen::Matrix3d scan_only_covariance_ = Eigen::Matrix3d::Zero();  // ... and its stated covariance
   bool have_scan_rotation_ = false;   // scan_only_pose_ is usable (the gyro's bias learns from it)
   bool have_scan_only_pose_ = false;  // ... and the wheels predicted that scan (their noise learns from it)
 
   int keyframe_id_ = 0;
+  int unexplained_scans_ = 0;  // usable scans in a row the map could not explain
 };
 
 }  // namespace hglasm

@@ -13,6 +13,7 @@
 #include "hglasm_odometry/core/motion_model.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
 #include "hglasm_odometry/core/pose2d.h"
+#include "hglasm_odometry/core/wheel_calibration.h"
 
 namespace hglasm {
 
@@ -24,6 +25,8 @@ struct MotionPrediction {
   PredictionSource source = PredictionSource::kNone;
   double dt = 0.0;  ///< seconds the motion spans
   Pose2D motion;
+  /// The wheels' own motion, before their learned systematic errors were removed (identity without them).
+  Pose2D wheel_motion;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   /// The wheels' part at unit noise scale (for learning their noise): zero where they predicted nothing.
   Eigen::Matrix3d nominal_covariance = Eigen::Matrix3d::Zero();
@@ -66,6 +69,9 @@ class PoseExtrapolator {
   /// Forgets the IMU samples (another timeline).
   void clearGyro() { gyro_.clear(); }
   const OdometryBuffer& odometry() const { return odometry_; }
+
+  /// The wheels' systematic errors, removed from their motion before it predicts (learned by the caller).
+  void setWheelCalibration(const WheelCalibration& calibration) { calibration_ = calibration; }
 
   /// Seconds the wheels' stamps run late: their pose of a scan's instant t is read at t + offset.
   void setOdometryTimeOffset(double offset) { odometry_time_offset_ = offset; }
@@ -115,6 +121,7 @@ class PoseExtrapolator {
   bool use_gyro_;
   GyroBuffer gyro_;
   double odometry_time_offset_ = 0.0;
+  WheelCalibration calibration_;
   double gyro_bias_ = 0.0;
   double gyro_bias_variance_;
   std::deque<StampedPose> poses_;  // recent estimates, for the velocity

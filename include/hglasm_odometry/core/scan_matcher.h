@@ -96,8 +96,9 @@ struct MatchResult {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  ///< of (x, y, theta); see Mbicp
   /// Calibrated information of the scan alone at `pose` (zero without an MbICP stage); see Mbicp.
   Eigen::Matrix3d scan_information = Eigen::Matrix3d::Zero();
-  bool degenerate = false;  ///< the scan alone leaves a direction unconstrained (see Mbicp)
-  Pose2D scan_only_pose;    ///< where the scan alone puts the pose (see Mbicp)
+  InformationDirections scan_directions;  ///< its directions before the noise scale (see Mbicp)
+  bool degenerate = false;                ///< the scan alone leaves a direction unconstrained (see Mbicp)
+  Pose2D scan_only_pose;                  ///< where the scan alone puts the pose (see Mbicp)
   double prealign_ms = 0.0;
   double refine_ms = 0.0;
 
@@ -135,13 +136,26 @@ class ScanMatcher {
   double logLikelihoodAt(const Scan& scan, const Pose2D& pose, double outlier) const;
 
   const MatcherOptions& options() const { return options_; }
-  const LookupTable& table() const { return table_; }
+  const LookupTable& table() const { return fineTable(); }
+  /// Lookup tables kept by the caller (a local map's, grown keyframe by keyframe, answering in the frame of
+  /// the reference given to setReference()), which then builds only MbICP's structure (and PGA's). nullptr:
+  /// the matcher's own, built by setReference().
+  void useTables(const LookupTable* fine, const LookupTable* coarse) {
+    external_fine_ = fine;
+    external_coarse_ = coarse;
+  }
+  /// How far the scan's information is to be believed, direction by direction (Mbicp::setScanNoiseScale).
+  void setScanNoiseScale(const ScanNoiseScale& scale) { mbicp_.setScanNoiseScale(scale); }
   void reseed(std::uint64_t seed) { aligner_.reseed(seed); }
 
  private:
   MatcherOptions options_;
   LookupTable table_;
   LookupTable coarse_table_;
+  const LookupTable* external_fine_ = nullptr;
+  const LookupTable* external_coarse_ = nullptr;
+  const LookupTable& fineTable() const { return external_fine_ ? *external_fine_ : table_; }
+  const LookupTable& coarseTable() const { return external_coarse_ ? *external_coarse_ : coarse_table_; }
   GeneticAligner aligner_;
   Mbicp mbicp_;
   PolarPairing polar_pairing_;  // PGA's "table": the reference sorted into angular steps

@@ -155,6 +155,9 @@ class LaserOdometry {
   hglasm::InputCounts input_counts_;  // the time policy's (pipeline_.inputCounts() after each scan)
   double time_offset_ = 0.0;          // the wheels' time offset in use, and its estimate
   double time_offset_estimate_ = 0.0;
+  double degeneracy_ = 0.0;  // of the last match's scan information, and its weakest direction
+  Eigen::Vector3d weakest_direction_ = Eigen::Vector3d::Zero();
+  hglasm::MotionNoiseScale noise_scale_;   // the wheels' learned so far
   std::uint32_t last_reported_drops_ = 0;  // dropped_scans_ at the previous diagnostics report
   ros::WallTime last_scan_time_;
   bool waiting_for_tf_ = false;

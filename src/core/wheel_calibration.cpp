@@ -1,0 +1,71 @@
+#include "hglasm_odometry/core/wheel_calibration.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+
+namespace hglasm {
+namespace {
+
+constexpr double kOutlierSigmas = 4.0;
+
+double square(double value) { return value * value; }
+
+}  // namespace
+
+WheelCalibration::WheelCalibration(const WheelCalibrationOptions& options) : options_(options) { reset(); }
+
+void WheelCalibration::reset() {
+  heading_.setZero();
+  heading_vector_.setZero();
+  heading_information_ = Eigen::Vector2d(1.0 / square(std::max(options_.turn_scale, 1e-9)),
+                                         1.0 / square(std::max(options_.heading_per_metre, 1e-9)))
+                             .asDiagonal();
+  distance_ = distance_vector_ = 0.0;
+  distance_information_ = 1.0 / square(std::max(options_.distance_scale, 1e-9));
+}
+
+Pose2D WheelCalibration::correct(const Pose2D& wheel_motion) const {
+  if (!wheel_motion.isFinite()) return wheel_motion;
+  const double distance = wheel_motion.translationNorm();
+  const double heading_error = heading_[0] * wheel_motion.theta + heading_[1] * distance;
+  // Along an arc the chord turns by half the rotation: with the rotation corrected, so is the chord.
+  const double c = std::cos(0.5 * heading_error), s = std::sin(0.5 * heading_error);
+  const double scale = 1.0 + distance_;
+  return Pose2D(scale * (c * wheel_motion.x - s * wheel_motion.y),
+                scale * (s * wheel_motion.x + c * wheel_motion.y), wheel_motion.theta + heading_error);
+}
+
+void WheelCalibration::learn(const Pose2D& wheel_motion, const Pose2D& scan_motion, double heading_variance,
+                             double distance_variance) {
+  if (!options_.learn || !wheel_motion.isFinite() || !scan_motion.isFinite()) return;
+  // Forgetting pulls the information back towards the prior's, so the estimates follow slow changes.
+  const double forget = std::exp2(-1.0 / std::max(1.0, options_.half_life));
+  const Eigen::Matrix2d prior = Eigen::Vector2d(1.0 / square(std::max(options_.turn_scale, 1e-9)),
+                                                1.0 / square(std::max(options_.heading_per_metre, 1e-9)))
+                                    .asDiagonal();
+  const double distance = wheel_motion.translationNorm();
+  const Eigen::Vector2d regressors(wheel_motion.theta, distance);
+  const double heading_residual = normalizeAngle(scan_motion.theta - wheel_motion.theta);
+  if (heading_variance > 0.0 &&
+      square(heading_residual - regressors.dot(heading_)) <= square(kOutlierSigmas) * heading_variance) {
+    heading_information_ = forget * heading_information_ + (1.0 - forget) * prior +
+                           regressors * regressors.transpose() / heading_variance;
+    heading_vector_ = forget * heading_vector_ + regressors * heading_residual / heading_variance;
+    heading_ = heading_information_.lu().solve(heading_vector_);
+  }
+  if (distance > 1e-3 && distance_variance > 0.0) {
+    // The scans' distance along the wheels' direction of travel.
+    const double along = (scan_motion.x * wheel_motion.x + scan_motion.y * wheel_motion.y) / distance;
+    const double residual = along - distance;
+    if (square(residual - distance_ * distance) <= square(kOutlierSigmas) * distance_variance) {
+      const double prior_distance = 1.0 / square(std::max(options_.distance_scale, 1e-9));
+      distance_information_ = forget * distance_information_ + (1.0 - forget) * prior_distance +
+                              distance * distance / distance_variance;
+      distance_vector_ = forget * distance_vector_ + distance * residual / distance_variance;
+      distance_ = distance_vector_ / distance_information_;
+    }
+  }
+}
+
+}  // namespace hglasm

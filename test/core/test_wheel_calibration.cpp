@@ -1,0 +1,86 @@
+// The wheels' systematic errors learned from the scans' motion, and removed from the wheels' motion.
+#include "hglasm_odometry/core/wheel_calibration.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace {
+
+using hglasm::Pose2D;
+using hglasm::WheelCalibration;
+using hglasm::WheelCalibrationOptions;
+
+/// Wheels that count turns `turn_scale` short (true turn = wheels' * (1 + turn_scale)), drift by
+/// `heading_per_metre`, and count distances `distance_scale` short; the scans see the true motion with
+/// noise. Returns the learned calibration.
+WheelCalibration learnFrom(double turn_scale, double heading_per_metre, double distance_scale, int steps,
+                           std::uint64_t seed) {
+  WheelCalibrationOptions options;
+  options.learn = true;
+  WheelCalibration calibration(options);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal;
+  const double heading_sigma = 0.002, distance_sigma = 0.005;
+  for (int i = 0; i < steps; ++i) {
+    const double distance = 0.2 + 0.1 * std::sin(0.03 * i);
+    const double turn = 0.3 * std::sin(0.05 * i);
+    const Pose2D truth(distance * std::cos(0.5 * turn), distance * std::sin(0.5 * turn), turn);
+    const double wheel_distance = distance / (1.0 + distance_scale);
+    const double wheel_turn = (turn - heading_per_metre * wheel_distance) / (1.0 + turn_scale);
+    const Pose2D wheels(wheel_distance * std::cos(0.5 * wheel_turn),
+                        wheel_distance * std::sin(0.5 * wheel_turn), wheel_turn);
+    const Pose2D scans(truth.x + distance_sigma * normal(rng), truth.y + distance_sigma * normal(rng),
+                       truth.theta + heading_sigma * normal(rng));
+    calibration.learn(wheels, scans, heading_sigma * heading_sigma, distance_sigma * distance_sigma);
+  }
+  return calibration;
+}
+
+TEST(WheelCalibration, LearnsATurnScaleAHeadingDriftAndADistanceScale) {
+  const WheelCalibration calibration = learnFrom(0.05, 0.01, 0.03, 5000, 1);
+  EXPECT_NEAR(calibration.turnScale(), 0.05, 0.005);
+  EXPECT_NEAR(calibration.headingPerMetre(), 0.01, 0.001);
+  EXPECT_NEAR(calibration.distanceScale(), 0.03, 0.003);
+  // Corrected, a wheel step is the true one.
+  const double wheel_distance = 0.5 / 1.03, wheel_turn = (0.4 - 0.01 * wheel_distance) / 1.05;
+  const Pose2D corrected = calibration.correct(Pose2D(
+      wheel_distance * std::cos(0.5 * wheel_turn), wheel_distance * std::sin(0.5 * wheel_turn), wheel_turn));
+  EXPECT_NEAR(corrected.theta, 0.4, 0.003);
+  EXPECT_NEAR(corrected.translationNorm(), 0.5, 0.003);
+  EXPECT_NEAR(std::atan2(corrected.y, corrected.x), 0.2, 0.003) << "the chord of the corrected arc";
+}
+
+TEST(WheelCalibration, CalibratedWheelsLearnNothingAndNothingIsCorrected) {
+  const WheelCalibration calibration = learnFrom(0.0, 0.0, 0.0, 5000, 2);
+  EXPECT_NEAR(calibration.turnScale(), 0.0, 0.003);
+  EXPECT_NEAR(calibration.headingPerMetre(), 0.0, 0.001);
+  EXPECT_NEAR(calibration.distanceScale(), 0.0, 0.003);
+  const WheelCalibration untouched;
+  const Pose2D step(0.31, -0.02, 0.17);
+  const Pose2D same = untouched.correct(step);
+  EXPECT_EQ(same.x, step.x);
+  EXPECT_EQ(same.y, step.y);
+  EXPECT_EQ(same.theta, step.theta);
+}
+
+TEST(WheelCalibration, AStepItCannotExplainIsLeftOutAndLearningCanBeOff) {
+  WheelCalibration calibration = learnFrom(0.0, 0.0, 0.0, 2000, 3);
+  const double before = calibration.turnScale();
+  // A slip: the scans saw a quarter turn the wheels did not count.
+  calibration.learn(Pose2D(0.2, 0.0, 0.1), Pose2D(0.2, 0.0, 0.1 + M_PI / 2), 1e-6, 1e-4);
+  EXPECT_EQ(calibration.turnScale(), before);
+  WheelCalibrationOptions off;  // learn is false by default
+  WheelCalibration fixed(off);
+  for (int i = 0; i < 100; ++i) fixed.learn(Pose2D(0.2, 0.0, 0.1), Pose2D(0.25, 0.0, 0.2), 1e-6, 1e-4);
+  EXPECT_EQ(fixed.turnScale(), 0.0);
+  EXPECT_EQ(fixed.distanceScale(), 0.0);
+  // Non-finite input changes nothing; an IMU's step (no heading variance) teaches the distance only.
+  calibration.learn(Pose2D(std::nan(""), 0.0, 0.0), Pose2D(), 1e-6, 1e-4);
+  EXPECT_TRUE(std::isfinite(calibration.turnScale()));
+  calibration.reset();
+  EXPECT_EQ(calibration.turnScale(), 0.0);
+}
+
+}  // namespace
