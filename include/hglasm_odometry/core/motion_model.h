@@ -21,7 +21,7 @@ struct MotionNoiseOptions {
   /// Wheels also miscount systematically (a wheel radius, a wheel base off by a fraction): an error that
   /// grows with the distance and the turn themselves, not their square roots. It dominates a long step (the
   /// wheels across a pause of minutes) and is never learned away. Fraction of the distance and the turn.
-  double systematic = 0.01;
+  double systematic = 0.0;
   /// Without wheel odometry the motion is extrapolated at the velocity of the last scans' poses. The guess
   /// is off by the velocity's own error times the step plus half the acceleration times its square.
   double constant_velocity_xy = 1.0;              ///< m/s per s: acceleration (standard deviation)
