@@ -90,6 +90,7 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
                                       double max_span) {
   RelationStats stats;
   std::vector<double> trans_errors, rot_errors_deg;
+  double along = 0.0, reference_distance = 0.0;
   for (std::size_t k = 0; k < relations.size(); ++k) {
     const Relation& relation = relations[k];
     if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
@@ -99,11 +100,17 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
     }
     // Kümmerle's estimated ⊖ reference: the residual motion left once the reference is undone.
     const Pose2D residual = relativePose(relation.motion, estimated[k]);
+    const double distance = relation.motion.translationNorm();
+    if (distance >= RelationStats::kScaleMinDistance) {
+      along += (estimated[k].x * relation.motion.x + estimated[k].y * relation.motion.y) / distance;
+      reference_distance += distance;
+    }
     trans_errors.push_back(residual.translationNorm());
     rot_errors_deg.push_back(std::abs(normalizeAngle(residual.theta)) * kRadToDeg);
   }
   stats.count = static_cast<int>(trans_errors.size());
   if (stats.count == 0) return stats;
+  if (reference_distance > 0.0) stats.along_track_scale = along / reference_distance;
   // Two passes (mean, then spread) so tiny spreads are not lost to cancellation.
   const auto moments = [](const std::vector<double>& values, double* mean, double* std_dev, double* sq_mean) {
     double sum = 0.0, sq_sum = 0.0;

@@ -89,6 +89,24 @@ TEST(Relations, MeanStdAndSquaresOfDifferentErrors) {
   EXPECT_NEAR(stats.rot_mean_deg, 0.0, 1e-12);
 }
 
+TEST(Relations, AlongTrackScaleIsTheDistanceEstimatedAlongTheReferencesOverTheirs) {
+  // 10 % too far along x, and a sideways error that does not count along the track; a relation that
+  // hardly moves (0.2 m) is left out of the scale.
+  std::vector<StampedPose> estimate;
+  for (int i = 0; i <= 10; ++i) estimate.push_back({static_cast<double>(i), Pose2D(1.1 * i, 0.05 * i, 0.0)});
+  const std::vector<Relation> relations = {{0.0, 1.0, Pose2D(1.0, 0.0, 0.0)},
+                                           {2.0, 5.0, Pose2D(3.0, 0.0, 0.0)},
+                                           {6.0, 7.0, Pose2D(0.2, 0.0, 0.0)}};
+  EXPECT_NEAR(evaluateRelations(relations, estimate, 0.0).along_track_scale, 1.1, 1e-12);
+  // One that falls short by half: (1.1 + 3.3 + 0.5 * 2) / (1 + 3 + 2).
+  estimate.push_back({20.0, Pose2D(0.0, 0.0, 0.0)});
+  estimate.push_back({21.0, Pose2D(1.0, 0.0, 0.0)});
+  std::vector<Relation> more = relations;
+  more.push_back({20.0, 21.0, Pose2D(2.0, 0.0, 0.0)});
+  EXPECT_NEAR(evaluateRelations(more, estimate, 0.0).along_track_scale, (1.1 + 3.3 + 1.0) / 6.0, 1e-12);
+  EXPECT_EQ(evaluateRelations({{6.0, 7.0, Pose2D(0.2, 0.0, 0.0)}}, estimate, 0.0).along_track_scale, 0.0);
+}
+
 TEST(Relations, RotationalErrorIsWrappedAndAbsolute) {
   // Reference turn of pi - 0.01, estimate -pi + 0.01 (the same heading crossed the other way):
   // a 0.02 rad error, not 2 pi - 0.02.

@@ -31,6 +31,12 @@ struct RelationStats {
   double rot_sq_mean_deg = 0.0;  ///< deg^2
   double trans_median = 0.0;     ///< metres: what a typical relation sees (a few leaps move the mean)
   double rot_median_deg = 0.0;
+  /// The distance travelled along the track as estimated against the reference's: over the relations that
+  /// move at least kScaleMinDistance, the estimated translations projected on the reference's directions,
+  /// summed, over the reference distances summed. 1 is unbiased; below 1 the estimate falls short (a scan
+  /// that prefers "no motion" along a featureless corridor), above it overshoots. 0 without such relations.
+  double along_track_scale = 0.0;
+  static constexpr double kScaleMinDistance = 0.5;  ///< metres
 };
 
 /// Evaluates the relations whose span |t2 - t1| is at most `max_span` seconds (<= 0: all) against
