@@ -14,6 +14,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -710,6 +711,51 @@ TEST(Fusion, AWheelSlipTheScansContradictIsOverruledAsALeap) {
   }
   EXPECT_GE(leaps, 1) << "the step over the slip";
   EXPECT_LE(leaps, 2) << "afterwards the wheels' increments are right again";
+}
+
+TEST(Fusion, DownAFeaturelessCorridorTheFusedDistanceIsUnbiased) {
+  // 1 m per scan down a corridor whose walls say nothing about the distance, with wheels whose distance
+  // and heading wander by a known small noise (a random walk, seeded): the fused motion along the corridor
+  // must be the wheels' (no pull towards "no motion" from a map of the scans just before), unbiased to
+  // 1 % of the distance, while across the corridor and in heading the walls correct the wheels.
+  const auto laser = hglasm_test::laserSpec(deg(270.0), 541, false, 8.0);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> normal;
+  std::vector<Pose2D> wheels;  // every 0.02 s over 41 s
+  double along = 0.0, across = 0.0, heading = 0.0;
+  for (int k = 0; k <= 2050; ++k) {
+    wheels.push_back(hglasm_test::rawPose(along, across, heading));
+    along += 0.02 * (1.0 + 0.1 * normal(rng));  // 1 m/s, 1.4 cm of distance noise per metre
+    heading += 0.0005 * normal(rng);            // 3.5 mrad per metre
+    across += 0.02 * std::sin(heading);
+  }
+  const Path noisy_wheels = [&wheels](double t) {
+    return wheels[std::min<std::size_t>(wheels.size() - 1, static_cast<std::size_t>(std::lround(t / 0.02)))];
+  };
+  Robot robot(TrackerOptions(), arcPath(1.0, 0.0), laser, hglasm_test::corridor(1.0, 200.0));
+  robot.enableOdometry();
+  robot.setOdometryPath(noisy_wheels);
+  TrackerUpdate previous = robot.step(0.0), update;
+  double along_error = 0.0, worst_across = 0.0, worst_heading = 0.0;
+  int steps = 0;
+  for (int i = 1; i <= 40; ++i) {  // one scan a second
+    update = robot.step(1.0 * i);
+    ASSERT_FALSE(update.fallback) << describe(update);
+    along_error += hglasm_test::relativeByHand(previous.pose, update.pose).x - 1.0;
+    worst_across = std::max(worst_across, std::abs(update.pose.y));
+    worst_heading = std::max(worst_heading, std::abs(update.pose.theta));
+    previous = update;
+    ++steps;
+  }
+  const double wheels_heading = std::abs(noisy_wheels(40.0).theta);
+  EXPECT_LT(std::abs(along_error / steps), 0.01) << "mean error along the corridor per metre travelled";
+  EXPECT_NEAR(update.pose.x, noisy_wheels(40.0).x, 0.02) << "along the corridor the wheels decide";
+  EXPECT_LT(worst_across, 0.03) << "across the corridor the walls decide";
+  EXPECT_LT(worst_heading, deg(0.5)) << "and in heading (the wheels end " << wheels_heading << " rad off)";
+  EXPECT_GT(wheels_heading, 2.0 * worst_heading) << "the scenario must test the walls";
+  // What the scene constrains is reported: nothing along the corridor.
+  EXPECT_LT(update.degeneracy, 1e-3) << describe(update);
+  EXPECT_GT(std::abs(update.weakest_direction.x()), 0.95) << update.weakest_direction.transpose();
 }
 
 TEST(Fusion, InACorridorTheWallsGiveTheHeadingAndTheWheelsTheDistance) {
