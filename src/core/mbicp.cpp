@@ -102,14 +102,9 @@ void Mbicp::setReference(const ReferencePoints& reference) {
       ref_normals_[i] = unitNormal(ref_points_[i] - ref_points_[i - 1]);
     }
   }
-  sorted_index_.resize(n);
-  std::iota(sorted_index_.begin(), sorted_index_.end(), 0);
-  std::vector<double> bearing(n);
-  for (std::size_t i = 0; i < n; ++i) bearing[i] = std::atan2(ref_points_[i].y(), ref_points_[i].x());
-  std::sort(sorted_index_.begin(), sorted_index_.end(),
-            [&](int a, int b) { return bearing[a] < bearing[b]; });
-  sorted_bearing_.resize(n);
-  for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
+  bins_.setMetric(options_.metric_l * options_.metric_l, std::min(options_.bearing_window, M_PI));
+  bins_.build(ref_points_, ref_has_next_);
+  last_element_.clear();
 }
 
 void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
@@ -134,6 +129,7 @@ void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidat
   const double d_sq = dapSquared(p, ref_points_[j], l_sq);
   if (d_sq < candidate->best) {
     candidate->best = d_sq, candidate->found = true;
+    candidate->code = 2 * static_cast<std::int64_t>(j);
     Association& association = candidate->association;
     association.target = ref_points_[j];
     association.normal = ref_normals_[j];
@@ -144,11 +140,11 @@ void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidat
   }
 }
 
-void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const {
+void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double u_scale,
+                            Candidate* candidate) const {
   // Closest point of segment j -> j+1 under the metric, with the metric frozen at p (it varies slowly):
   // minimise (a - t e)^T M (a - t e), M = I - u u^T / (|p|^2 + L^2), u = (p_y, -p_x).
   const Eigen::Vector2d u(p.y(), -p.x());
-  const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
   const Eigen::Vector2d& q = ref_points_[j];
   const Eigen::Vector2d e = ref_points_[j + 1] - q;
   const Eigen::Vector2d a = p - q;
@@ -161,6 +157,7 @@ void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, Candid
   const double d_sq = dapSquared(p, on_segment, l_sq);
   if (d_sq < candidate->best) {
     candidate->best = d_sq, candidate->found = true;
+    candidate->code = 2 * static_cast<std::int64_t>(j) + 1;
     Association& association = candidate->association;
     association.target = on_segment;
     association.normal = unitNormal(e);
@@ -170,67 +167,34 @@ void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, Candid
   }
 }
 
-void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
-                      std::vector<Association>* out) const {
+void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) {
   out->clear();
   const double l_sq = options_.metric_l * options_.metric_l;
   const double gate_sq = gate * gate;
-  const double window = std::min(options_.bearing_window, M_PI);
-
-  for (const auto& p : moved) {
+  last_element_.resize(moved.size(), -1);
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    const Eigen::Vector2d& p = moved[i];
+    const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
+    const auto consider = [&](std::int64_t code, Candidate* candidate) {
+      const int j = static_cast<int>(code >> 1);
+      if (code & 1) {
+        considerSegment(p, j, l_sq, u_scale, candidate);
+      } else {
+        considerPoint(p, j, l_sq, candidate);
+      }
+    };
     Candidate candidate;
     candidate.best = gate_sq;
-    double& best = candidate.best;
-
-    // Walk outward in bearing from p's own bearing, both ways, within the window (wrapping at +-pi for
-    // 360-degree scans). A reference point at bearing offset D is at least |p| sin D away from p, and
-    // d_ap^2 >= |d|^2 L^2 / ((|p| + |d|)^2 + L^2), which grows with |d|: once that bound exceeds the
-    // best candidate so far, nothing farther in bearing can win, and the walk stops.
-    const double bearing = std::atan2(p.y(), p.x());
-    const double range = p.norm();
-    const int n = static_cast<int>(sorted_bearing_.size());
-    const int start = static_cast<int>(
-        std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), bearing) - sorted_bearing_.begin());
-    double reach = window;
-    double reach_best = -1.0;
-    auto update_reach = [&]() {
-      // Smallest |d| whose bound reaches `best`: root of d^2 (L^2 - best) - 2 best |p| d - best (|p|^2 +
-      // L^2).
-      reach_best = best;
-      const double denominator = l_sq - best;
-      if (!(denominator > 0.0) || !(range > 0.0)) {
-        reach = window;
-        return;
-      }
-      const double d_min = (best * range + std::sqrt(best * best * range * range +
-                                                     denominator * best * (range * range + l_sq))) /
-                           denominator;
-      reach = d_min >= range ? window : std::min(window, std::asin(d_min / range));
-    };
-    auto visit = [&](int j) {
-      considerPoint(p, j, l_sq, &candidate);
-      if (ref_has_next_[j]) considerSegment(p, j, l_sq, &candidate);
-      if (j > 0 && ref_has_next_[j - 1]) considerSegment(p, j - 1, l_sq, &candidate);
-      // The reach from a larger `best` is still a valid (looser) bound: refresh only on a real gain.
-      if (best < 0.5 * reach_best) update_reach();
-    };
-    update_reach();
-    for (int step = 0; step < n; ++step) {  // counter-clockwise
-      int k = start + step;
-      double offset = (k >= n ? sorted_bearing_[k -= n] + 2.0 * M_PI : sorted_bearing_[k]) - bearing;
-      if (offset > reach) break;
-      visit(sorted_index_[k]);
-    }
-    for (int step = 1; step < n; ++step) {  // clockwise
-      int k = start - step;
-      double offset = bearing - (k < 0 ? sorted_bearing_[k += n] - 2.0 * M_PI : sorted_bearing_[k]);
-      if (offset > reach) break;
-      visit(sorted_index_[k]);
-    }
-
+    // The last iteration's element first: the pose moved little, so it bounds the search tightly.
+    const std::int64_t last = last_element_[i];
+    if (last >= 0) consider(last, &candidate);
+    bins_.search(p, &candidate.best, last, [&](int j, bool segment) {
+      consider(2 * static_cast<std::int64_t>(j) + (segment ? 1 : 0), &candidate);
+    });
+    last_element_[i] = candidate.found ? candidate.code : -1;
     if (candidate.found) {
       candidate.association.point = p;
-      candidate.association.distance_sq = std::max(0.0, best);
+      candidate.association.distance_sq = std::max(0.0, candidate.best);
       candidate.association.weight = 1.0;
       out->push_back(candidate.association);
     }
