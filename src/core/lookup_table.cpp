@@ -51,7 +51,7 @@ void LookupTable::buildKernel() {
 std::uint32_t LookupTable::maxCellValue() const { return options_.kind == TableKind::kGraded ? 255u : 1u; }
 
 std::size_t LookupTable::memoryBytes() const {
-  return tile_index_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() + stamped_.capacity() +
+  return tile_offset_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() + stamped_.capacity() +
          kernel_.capacity();
 }
 
@@ -109,75 +109,80 @@ void LookupTable::collectSamples(const ReferencePoints& reference_set) {
   if (options_.isolated_footprint > 0.0) stampFootprints(reference_set, joins, spacing);
 }
 
-void LookupTable::build(const ReferencePoints& reference_set) {
-  const std::vector<Eigen::Vector2d>& reference = reference_set.points;
-  tiles_in_use_ = 0;
-  tiles_x_ = tiles_y_ = 0;
-  tile_index_.clear();
-
-  // Global cell coordinates of the usable reference points, and their bounding box.
-  long min_cx = 0, max_cx = -1, min_cy = 0, max_cy = -1;
-  std::vector<std::pair<long, long>> cells;
-  cells.reserve(reference.size());
+bool LookupTable::collectCells(const ReferencePoints& reference_set, Box* box) {
   collectSamples(reference_set);
+  cells_.clear();
   for (const auto& p : samples_) {
     if (std::abs(p.x()) > kMaxCoordinate || std::abs(p.y()) > kMaxCoordinate) continue;
     const long cx = static_cast<long>(std::floor(p.x() * inv_cell_size_));
     const long cy = static_cast<long>(std::floor(p.y() * inv_cell_size_));
-    if (cells.empty()) {
-      min_cx = max_cx = cx;
-      min_cy = max_cy = cy;
+    if (cells_.empty()) {
+      box->min_x = box->max_x = cx;
+      box->min_y = box->max_y = cy;
     } else {
-      min_cx = std::min(min_cx, cx), max_cx = std::max(max_cx, cx);
-      min_cy = std::min(min_cy, cy), max_cy = std::max(max_cy, cy);
+      box->min_x = std::min(box->min_x, cx), box->max_x = std::max(box->max_x, cx);
+      box->min_y = std::min(box->min_y, cy), box->max_y = std::max(box->max_y, cy);
     }
-    cells.emplace_back(cx, cy);
+    cells_.emplace_back(cx, cy);
   }
-  if (cells.empty()) return;
+  return !cells_.empty();
+}
 
-  // Tile grid covering the box grown by the kernel radius; only touched tiles get cells.
+void LookupTable::allocateTiles(const Box& box) {
+  // Tile grid covering the box grown by the kernel radius, inside a ring of zero tiles (lookups clamped
+  // onto the ring read zero); only touched tiles get cells, the others share the zero tile.
   const long r = kernel_radius_;
   const auto floor_div = [](long a) {
     return a >= 0 ? a >> kTileShift : -((-a + kTileSize - 1) >> kTileShift);
   };
-  const long first_tile_x = floor_div(min_cx - r), last_tile_x = floor_div(max_cx + r);
-  const long first_tile_y = floor_div(min_cy - r), last_tile_y = floor_div(max_cy + r);
+  const long first_tile_x = floor_div(box.min_x - r), last_tile_x = floor_div(box.max_x + r);
+  const long first_tile_y = floor_div(box.min_y - r), last_tile_y = floor_div(box.max_y + r);
   tiles_x_ = last_tile_x - first_tile_x + 1;
   tiles_y_ = last_tile_y - first_tile_y + 1;
   origin_cell_x_ = first_tile_x * kTileSize;
   origin_cell_y_ = first_tile_y * kTileSize;
-  tile_index_.assign(static_cast<std::size_t>(tiles_x_ * tiles_y_), -1);
-
-  for (const auto& cell : cells) {
+  tile_offset_.assign(static_cast<std::size_t>((tiles_x_ + 2) * (tiles_y_ + 2)), -1);
+  for (const auto& cell : cells_) {
     const long lx0 = cell.first - r - origin_cell_x_, lx1 = cell.first + r - origin_cell_x_;
     const long ly0 = cell.second - r - origin_cell_y_, ly1 = cell.second + r - origin_cell_y_;
     for (long ty = ly0 >> kTileShift; ty <= (ly1 >> kTileShift); ++ty) {
       for (long tx = lx0 >> kTileShift; tx <= (lx1 >> kTileShift); ++tx) {
-        std::int32_t& index = tile_index_[ty * tiles_x_ + tx];
-        if (index < 0) index = static_cast<std::int32_t>(tiles_in_use_++);
+        std::int32_t& offset = tile_offset_[(ty + 1) * (tiles_x_ + 2) + tx + 1];
+        if (offset < 0) offset = static_cast<std::int32_t>(tiles_in_use_++ * kTileCells);
       }
     }
   }
-  tile_cells_.assign(tiles_in_use_ * kTileCells, 0);
+  const auto zero_tile = static_cast<std::int32_t>(tiles_in_use_ * kTileCells);
+  for (std::int32_t& offset : tile_offset_) {
+    if (offset < 0) offset = zero_tile;
+  }
+  tile_cells_.assign((tiles_in_use_ + 1) * kTileCells, 0);
+}
+
+void LookupTable::build(const ReferencePoints& reference_set) {
+  tiles_in_use_ = 0;
+  tiles_x_ = tiles_y_ = 0;
+  tile_offset_.clear();
+  Box box;
+  if (!collectCells(reference_set, &box)) return;
+  allocateTiles(box);
 
   // Stamp the kernel around each point, keeping the maximum (likelihood of the nearest point). A stamp
   // depends on the centre's cell only: overlapping keyframes and close samples put many in one cell, which
   // is stamped once.
   stamped_.assign(tiles_in_use_ * kTileCells, 0);
+  const long r = kernel_radius_;
   const long side = 2 * r + 1;
-  for (const auto& cell : cells) {
+  for (const auto& cell : cells_) {
     const long cx = cell.first - origin_cell_x_, cy = cell.second - origin_cell_y_;
-    std::uint8_t& centre =
-        stamped_[static_cast<std::size_t>(tile_index_[(cy >> kTileShift) * tiles_x_ + (cx >> kTileShift)]) *
-                     kTileCells +
-                 ((cy & (kTileSize - 1)) << kTileShift) + (cx & (kTileSize - 1))];
+    std::uint8_t& centre = stamped_[cellOffset(cx, cy)];
     if (centre) continue;
     centre = 1;
     const long lx0 = cx - r;
     const long ly0 = cy - r;
     for (long ky = 0; ky < side; ++ky) {
       const long ly = ly0 + ky;
-      const std::int32_t* index_row = &tile_index_[(ly >> kTileShift) * tiles_x_];
+      const std::int32_t* offset_row = tileOffsets() + (ly >> kTileShift) * (tiles_x_ + 2);
       const std::uint8_t* kernel_row = &kernel_[ky * side];
       const long cell_row = (ly & (kTileSize - 1)) << kTileShift;
       // The row's non-zero span, in runs that stay within one tile: contiguous bytes the compiler
@@ -187,9 +192,7 @@ void LookupTable::build(const ReferencePoints& reference_set) {
         const long lx = lx0 + kx;
         const long in_tile = lx & (kTileSize - 1);
         const long run = std::min(end - kx, kTileSize - in_tile);
-        std::uint8_t* target =
-            &tile_cells_[static_cast<std::size_t>(index_row[lx >> kTileShift]) * kTileCells + cell_row +
-                         in_tile];
+        std::uint8_t* target = &tile_cells_[offset_row[lx >> kTileShift] + cell_row + in_tile];
         const std::uint8_t* value = kernel_row + kx;
         for (long i = 0; i < run; ++i) target[i] = std::max(target[i], value[i]);
         kx += run;
@@ -203,11 +206,7 @@ std::uint8_t LookupTable::valueAt(const Eigen::Vector2d& point) const {
   const double fx = point.x() * inv_cell_size_ - origin_cell_x_;
   const double fy = point.y() * inv_cell_size_ - origin_cell_y_;
   if (!(fx >= 0.0 && fy >= 0.0 && fx < tiles_x_ * kTileSize && fy < tiles_y_ * kTileSize)) return 0;
-  const long lx = static_cast<long>(fx), ly = static_cast<long>(fy);
-  const std::int32_t index = tile_index_[(ly >> kTileShift) * tiles_x_ + (lx >> kTileShift)];
-  if (index < 0) return 0;
-  return tile_cells_[static_cast<std::size_t>(index) * kTileCells + ((ly & (kTileSize - 1)) << kTileShift) +
-                     (lx & (kTileSize - 1))];
+  return tile_cells_[cellOffset(static_cast<long>(fx), static_cast<long>(fy))];
 }
 
 int LookupTable::beamsThroughSurfaces(const std::vector<Eigen::Vector2d>& points, const Pose2D& sensor,
