@@ -56,6 +56,7 @@ int BearingBins::binOf(const Eigen::Vector2d& p) const {
 void BearingBins::setMetric(double l_sq, double window) {
   l_sq_ = l_sq;
   cos_window_ = window >= M_PI ? -2.0 : std::cos(window);
+  sin_sq_window_ = window >= 0.5 * M_PI ? 1.0 : std::sin(window) * std::sin(window);
 }
 
 void BearingBins::update(double range, double best, Bounds* bounds) const {
@@ -66,6 +67,8 @@ void BearingBins::update(double range, double best, Bounds* bounds) const {
   const double limit = l_sq_ > 0.0 ? std::max(best, 0.0) * (far * far + l_sq_) / l_sq_ : HUGE_VAL;
   bounds->bearing_bounded = limit < range * range;
   bounds->cross_sq_limit = limit * (1.0 + kSlack);
+  bounds->window_binds = cos_window_ > -2.0 && (!bounds->bearing_bounded ||
+                                                limit >= sin_sq_window_ * range * range * (1.0 - kSlack));
   bounds->range_low = bounds->bearing_bounded
                           ? range * std::sqrt(1.0 - limit / (range * range)) * (1.0 - kSlack) - root - kSlack
                           : -HUGE_VAL;
@@ -90,7 +93,12 @@ void BearingBins::collectElements(const std::vector<Eigen::Vector2d>& points,
   const int n = static_cast<int>(points.size());
   const int bins = mask_ + 1;
   point_bin_.resize(points.size());
-  for (int i = 0; i < n; ++i) point_bin_[i] = points[i].norm() > kNoBearing ? binOf(points[i]) : -1;
+  directions_.resize(points.size());
+  for (int i = 0; i < n; ++i) {
+    const double range = points[i].norm();
+    point_bin_[i] = range > kNoBearing ? binOf(points[i]) : -1;
+    directions_[i] = range > kNoBearing ? Eigen::Vector2d(points[i] / range) : Eigen::Vector2d::Zero();
+  }
   elements_.clear();
   for (int i = 0; i < n; ++i) {
     const double range = points[i].norm();

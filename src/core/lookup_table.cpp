@@ -141,13 +141,15 @@ void LookupTable::allocateTiles(const Box& box) {
   tiles_y_ = last_tile_y - first_tile_y + 1;
   origin_cell_x_ = first_tile_x * kTileSize;
   origin_cell_y_ = first_tile_y * kTileSize;
-  tile_offset_.assign(static_cast<std::size_t>((tiles_x_ + 2) * (tiles_y_ + 2)), -1);
+  stride_shift_ = 0;
+  while ((1L << stride_shift_) < tiles_x_ + 2) ++stride_shift_;
+  tile_offset_.assign(static_cast<std::size_t>((tiles_y_ + 2) << stride_shift_), -1);
   for (const auto& cell : cells_) {
     const long lx0 = cell.first - r - origin_cell_x_, lx1 = cell.first + r - origin_cell_x_;
     const long ly0 = cell.second - r - origin_cell_y_, ly1 = cell.second + r - origin_cell_y_;
     for (long ty = ly0 >> kTileShift; ty <= (ly1 >> kTileShift); ++ty) {
       for (long tx = lx0 >> kTileShift; tx <= (lx1 >> kTileShift); ++tx) {
-        std::int32_t& offset = tile_offset_[(ty + 1) * (tiles_x_ + 2) + tx + 1];
+        std::int32_t& offset = tile_offset_[tileSlot(tx << kTileShift, ty << kTileShift, stride_shift_)];
         if (offset < 0) offset = static_cast<std::int32_t>(tiles_in_use_++ * kTileCells);
       }
     }
@@ -182,7 +184,7 @@ void LookupTable::build(const ReferencePoints& reference_set) {
     const long ly0 = cy - r;
     for (long ky = 0; ky < side; ++ky) {
       const long ly = ly0 + ky;
-      const std::int32_t* offset_row = tileOffsets() + (ly >> kTileShift) * (tiles_x_ + 2);
+      const std::int32_t* offset_row = &tile_offset_[tileSlot(0, ly, stride_shift_)];
       const std::uint8_t* kernel_row = &kernel_[ky * side];
       const long cell_row = (ly & (kTileSize - 1)) << kTileShift;
       // The row's non-zero span, in runs that stay within one tile: contiguous bytes the compiler

@@ -30,7 +30,8 @@ class BearingBins {
   void setMetric(double l_sq, double window);
 
   /// Calls visit(index, is_segment) for every point and segment that may lie closer to p than *best
-  /// (d_ap^2) within the window of p's bearing. visit may lower *best: the search narrows as it does.
+  /// (d_ap^2) within the window: a point whose bearing is within it of p's, a segment with such an end
+  /// point. visit may lower *best: the search narrows as it does.
   /// Segments are visited at most once per search; `skip` (index * 2 + is_segment, or -1) not at all.
   template <typename Visit>
   void search(const Eigen::Vector2d& p, double* best, std::int64_t skip, Visit&& visit);
@@ -50,11 +51,18 @@ class BearingBins {
     bool bearing_bounded = false;  // s < 1: cross^2 < cross_sq_limit bounds the bearing
     double cross_sq_limit = 0.0;   // s^2 |p|^2
     double dot_limit = 0.0;        // dot with an edge must exceed this (the window)
+    bool window_binds = false;     // the window, not the metric, limits the bearing: elements checked
     double range_low = 0.0;
     double range_high = 0.0;
   };
   void update(double range, double best, Bounds* bounds) const;
   /// True if a bin whose nearest edge has this dot and cross product with p may hold a candidate.
+  bool withinWindow(const Eigen::Vector2d& p, std::uint32_t index, bool segment, const Bounds& bounds) const {
+    const auto within = [&](std::uint32_t i) {
+      return directions_[i].isZero() || p.dot(directions_[i]) > bounds.dot_limit;
+    };
+    return within(index) || (segment && within(index + 1));
+  }
   static bool mayHold(double dot, double cross, const Bounds& bounds) {
     return dot > bounds.dot_limit &&
            (!bounds.bearing_bounded || (dot > 0.0 && cross * cross < bounds.cross_sq_limit));
@@ -72,6 +80,8 @@ class BearingBins {
 
   double l_sq_ = 9.0;
   double cos_window_ = -2.0;  // -2: no window
+  double sin_sq_window_ = 0.0;
+  std::vector<Eigen::Vector2d> directions_;  // unit bearing of each point (zero next to the origin)
   int mask_ = 0;
   double bins_per_radian_ = 0.0;
   std::vector<Eigen::Vector2d> edges_;  // unit vector of each bin's clockwise edge
@@ -104,6 +114,7 @@ void BearingBins::search(const Eigen::Vector2d& p, double* best, std::int64_t sk
       if (entry.code == skip) continue;
       const std::uint32_t index = entry.code >> 1;
       const bool segment = entry.code & 1u;
+      if (bounds.window_binds && !withinWindow(p, index, segment, bounds)) continue;
       if (segment) {
         if (seen_[index] == search_id_) continue;
         seen_[index] = search_id_;

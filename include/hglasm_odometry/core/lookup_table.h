@@ -106,11 +106,13 @@ class LookupTable {
   /// The stamp centres' global cells (cells_) and their bounding box; false if there is none.
   bool collectCells(const ReferencePoints& reference, Box* box);
   void allocateTiles(const Box& box);
-  /// The first interior tile's entry of tile_offset_ (tile (-1, -1) of the ring is at [-stride - 1]).
-  const std::int32_t* tileOffsets() const { return tile_offset_.data() + tiles_x_ + 3; }
+  /// tile_offset_'s entry of the tile holding table cell (x, y), x and y >= -kTileSize (the ring).
+  static long tileSlot(long x, long y, int stride_shift) {
+    return (((y >> kTileShift) + 1) << stride_shift) + (x >> kTileShift) + 1;
+  }
   /// Index into tile_cells_ (or stamped_) of the cell at table coordinates (x, y), x and y >= -kTileSize.
   std::size_t cellOffset(long x, long y) const {
-    return static_cast<std::size_t>(tileOffsets()[(y >> kTileShift) * (tiles_x_ + 2) + (x >> kTileShift)]) +
+    return static_cast<std::size_t>(tile_offset_[tileSlot(x, y, stride_shift_)]) +
            static_cast<std::size_t>(((y & (kTileSize - 1)) << kTileShift) + (x & (kTileSize - 1)));
   }
   /// Stamp centres (samples_): the points, samples along joined gaps and isolated points' footprints.
@@ -133,11 +135,11 @@ class LookupTable {
     constexpr float kRing = static_cast<float>(kTileSize);
     const float max_x = static_cast<float>(tiles_x_ * kTileSize) + kRing - 1.0f;
     const float max_y = static_cast<float>(tiles_y_ * kTileSize) + kRing - 1.0f;
-    const std::int32_t* offsets = tileOffsets();
+    const std::int32_t* offsets = tile_offset_.data();
     const std::uint8_t* cells = tile_cells_.data();
-    const std::int32_t stride = static_cast<std::int32_t>(tiles_x_ + 2);
+    const int stride_shift = stride_shift_;
     constexpr std::size_t kBlock = 64;
-    std::int32_t cell_x[kBlock], cell_y[kBlock];
+    std::int32_t tile[kBlock], in_tile[kBlock];
     const std::size_t n = points.size();
     const float* px = points.x.data();
     const float* py = points.y.data();
@@ -146,14 +148,12 @@ class LookupTable {
       for (std::size_t i = 0; i < count; ++i) {
         const float fx = c * px[begin + i] - s * py[begin + i] + ox;
         const float fy = s * px[begin + i] + c * py[begin + i] + oy;
-        cell_x[i] = static_cast<std::int32_t>(std::min(std::max(-kRing, fx), max_x));
-        cell_y[i] = static_cast<std::int32_t>(std::min(std::max(-kRing, fy), max_y));
+        const auto lx = static_cast<std::int32_t>(std::min(std::max(-kRing, fx), max_x));
+        const auto ly = static_cast<std::int32_t>(std::min(std::max(-kRing, fy), max_y));
+        tile[i] = static_cast<std::int32_t>(tileSlot(lx, ly, stride_shift));
+        in_tile[i] = ((ly & (kTileSize - 1)) << kTileShift) + (lx & (kTileSize - 1));
       }
-      for (std::size_t i = 0; i < count; ++i) {
-        const std::int32_t lx = cell_x[i], ly = cell_y[i];
-        f(cells[offsets[(ly >> kTileShift) * stride + (lx >> kTileShift)] +
-                ((ly & (kTileSize - 1)) << kTileShift) + (lx & (kTileSize - 1))]);
-      }
+      for (std::size_t i = 0; i < count; ++i) f(cells[offsets[tile[i]] + in_tile[i]]);
     }
   }
 
@@ -163,9 +163,10 @@ class LookupTable {
   long origin_cell_y_ = 0;
   long tiles_x_ = 0;
   long tiles_y_ = 0;
-  /// (tiles_x_ + 2) * (tiles_y_ + 2), the ring included: each tile's first cell in tile_cells_ (the zero
-  /// tile's where it has no cells).
+  /// Rows of 2^stride_shift_ >= tiles_x_ + 2 tiles, tiles_y_ + 2 of them, the ring included: each tile's
+  /// first cell in tile_cells_ (the zero tile's where it has no cells).
   std::vector<std::int32_t> tile_offset_;
+  int stride_shift_ = 0;
   std::vector<std::uint8_t> tile_cells_;  // (tiles_in_use_ + 1) * kTileCells, the zero tile last
   std::size_t tiles_in_use_ = 0;
   std::vector<Eigen::Vector2d> samples_;             // scratch: stamp centres
