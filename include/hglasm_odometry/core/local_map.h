@@ -5,7 +5,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
-#include <unordered_map>
 #include <vector>
 
 #include "hglasm_odometry/core/pose2d.h"
@@ -57,17 +56,27 @@ class LocalMap {
   /// True if a point of a keyframe added before lies within options_.resolution of `point`.
   bool covered(const Eigen::Vector2d& point) const;
   void remember(const Eigen::Vector2d& point);
-  std::uint64_t cellKey(const Eigen::Vector2d& point, int dx, int dy) const;
+  /// Empties the grid of remembered points, sized for up to `points` of them.
+  void resetGrid(std::size_t points);
+  /// The grid's slot of a cell: where it is, or the empty slot where it would go.
+  std::size_t slotOf(std::int64_t cx, std::int64_t cy) const;
 
   LocalMapOptions options_;
   std::deque<Keyframe> keyframes_;  // oldest first
   Pose2D frame_;
   ReferencePoints reference_;
   std::uint64_t revision_ = 0;
-  // Scratch of rebuild(): kept points by grid cell (cell side = resolution).
-  std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> cells_;
-  std::vector<Eigen::Vector2d> kept_;  // in the keyframe's frame
-  std::vector<std::uint8_t> covered_;  // per point of the keyframe being added: an older keyframe has it
+  // Scratch of rebuild(): kept points by grid cell (side twice the resolution, so the points within the
+  // resolution of any point lie in at most 2 x 2 cells), an open-addressing table of cells, each the head
+  // of a list of its points.
+  double cell_side_ = 0.0;
+  std::vector<std::uint64_t> cell_keys_;
+  std::vector<std::int32_t> cell_heads_;  // -1: empty slot
+  std::vector<std::int32_t> next_in_cell_;
+  std::vector<Eigen::Vector2d> remembered_;
+  std::vector<Eigen::Vector2d> moved_;  // the keyframe's points in frame()
+  std::vector<Eigen::Vector2d> kept_;   // those kept
+  std::vector<std::uint8_t> covered_;   // per point of the keyframe being added: an older keyframe has it
 };
 
 }  // namespace hglasm
