@@ -102,9 +102,19 @@ void Mbicp::setReference(const ReferencePoints& reference) {
       ref_normals_[i] = unitNormal(ref_points_[i] - ref_points_[i - 1]);
     }
   }
-  bins_.setMetric(options_.metric_l * options_.metric_l, std::min(options_.bearing_window, M_PI));
-  bins_.build(ref_points_, ref_has_next_);
-  last_element_.clear();
+  sorted_index_.resize(n);
+  std::iota(sorted_index_.begin(), sorted_index_.end(), 0);
+  std::vector<double> bearing(n);
+  for (std::size_t i = 0; i < n; ++i) bearing[i] = std::atan2(ref_points_[i].y(), ref_points_[i].x());
+  std::sort(sorted_index_.begin(), sorted_index_.end(),
+            [&](int a, int b) { return bearing[a] < bearing[b]; });
+  sorted_bearing_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
+  const double l_sq = options_.metric_l * options_.metric_l;
+  ref_metric_scale_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) ref_metric_scale_[i] = ref_points_[i].squaredNorm() + l_sq;
+  segment_seen_.assign(n, 0u);
+  walk_id_ = 0;
 }
 
 void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
@@ -125,11 +135,14 @@ void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
   }
 }
 
-void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const {
-  const double d_sq = dapSquared(p, ref_points_[j], l_sq);
+void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double, Candidate* candidate) const {
+  // dapSquared() with the point's |q|^2 + L^2 precomputed.
+  const Eigen::Vector2d& q = ref_points_[j];
+  const Eigen::Vector2d d = p - q;
+  const double cross = d.x() * q.y() - d.y() * q.x();
+  const double d_sq = d.squaredNorm() - cross * cross / ref_metric_scale_[j];
   if (d_sq < candidate->best) {
     candidate->best = d_sq, candidate->found = true;
-    candidate->code = 2 * static_cast<std::int64_t>(j);
     Association& association = candidate->association;
     association.target = ref_points_[j];
     association.normal = ref_normals_[j];
@@ -157,7 +170,6 @@ void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double
   const double d_sq = dapSquared(p, on_segment, l_sq);
   if (d_sq < candidate->best) {
     candidate->best = d_sq, candidate->found = true;
-    candidate->code = 2 * static_cast<std::int64_t>(j) + 1;
     Association& association = candidate->association;
     association.target = on_segment;
     association.normal = unitNormal(e);
@@ -167,31 +179,73 @@ void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double
   }
 }
 
+void Mbicp::associatePoint(const Eigen::Vector2d& p, double gate_sq, Candidate* candidate) {
+  const double l_sq = options_.metric_l * options_.metric_l;
+  const double window = std::min(options_.bearing_window, M_PI);
+  const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
+  double& best = candidate->best;
+  best = gate_sq;
+  if (++walk_id_ == 0) {
+    std::fill(segment_seen_.begin(), segment_seen_.end(), 0u);
+    walk_id_ = 1;
+  }
+  // Walk outward in bearing from p's own bearing, both ways, within the window (wrapping at +-pi for
+  // 360-degree scans). A reference point at bearing offset D is at least |p| sin D away from p, and
+  // d_ap^2 >= |d|^2 L^2 / ((|p| + |d|)^2 + L^2), which grows with |d|: once that bound exceeds the
+  // best candidate so far, nothing farther in bearing can win, and the walk stops.
+  const double bearing = std::atan2(p.y(), p.x());
+  const double range = p.norm();
+  const int n = static_cast<int>(sorted_bearing_.size());
+  const int start = static_cast<int>(
+      std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), bearing) - sorted_bearing_.begin());
+  double reach = window;
+  double reach_best = -1.0;
+  auto update_reach = [&]() {
+    // Smallest |d| whose bound reaches `best`: root of d^2 (L^2 - best) - 2 best |p| d - best (|p|^2 + L^2).
+    reach_best = best;
+    const double denominator = l_sq - best;
+    if (!(denominator > 0.0) || !(range > 0.0)) {
+      reach = window;
+      return;
+    }
+    const double d_min = (best * range + std::sqrt(best * best * range * range +
+                                                   denominator * best * (range * range + l_sq))) /
+                         denominator;
+    reach = d_min >= range ? window : std::min(window, std::asin(d_min / range));
+  };
+  // A segment is considered from either end point, once (a second time could not change the best).
+  const auto segment = [&](int j) {
+    if (!ref_has_next_[j] || segment_seen_[j] == walk_id_) return;
+    segment_seen_[j] = walk_id_;
+    considerSegment(p, j, l_sq, u_scale, candidate);
+  };
+  auto visit = [&](int j) {
+    considerPoint(p, j, l_sq, candidate);
+    segment(j);
+    if (j > 0) segment(j - 1);
+    // The reach from a larger `best` is still a valid (looser) bound: refresh only on a real gain.
+    if (best < 0.5 * reach_best) update_reach();
+  };
+  update_reach();
+  for (int step = 0; step < n; ++step) {  // counter-clockwise
+    int k = start + step;
+    double offset = (k >= n ? sorted_bearing_[k -= n] + 2.0 * M_PI : sorted_bearing_[k]) - bearing;
+    if (offset > reach) break;
+    visit(sorted_index_[k]);
+  }
+  for (int step = 1; step < n; ++step) {  // clockwise
+    int k = start - step;
+    double offset = bearing - (k < 0 ? sorted_bearing_[k += n] - 2.0 * M_PI : sorted_bearing_[k]);
+    if (offset > reach) break;
+    visit(sorted_index_[k]);
+  }
+}
+
 void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) {
   out->clear();
-  const double l_sq = options_.metric_l * options_.metric_l;
-  const double gate_sq = gate * gate;
-  last_element_.resize(moved.size(), -1);
-  for (std::size_t i = 0; i < moved.size(); ++i) {
-    const Eigen::Vector2d& p = moved[i];
-    const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
-    const auto consider = [&](std::int64_t code, Candidate* candidate) {
-      const int j = static_cast<int>(code >> 1);
-      if (code & 1) {
-        considerSegment(p, j, l_sq, u_scale, candidate);
-      } else {
-        considerPoint(p, j, l_sq, candidate);
-      }
-    };
+  for (const auto& p : moved) {
     Candidate candidate;
-    candidate.best = gate_sq;
-    // The last iteration's element first: the pose moved little, so it bounds the search tightly.
-    const std::int64_t last = last_element_[i];
-    if (last >= 0) consider(last, &candidate);
-    bins_.search(p, &candidate.best, last, [&](int j, bool segment) {
-      consider(2 * static_cast<std::int64_t>(j) + (segment ? 1 : 0), &candidate);
-    });
-    last_element_[i] = candidate.found ? candidate.code : -1;
+    associatePoint(p, gate * gate, &candidate);
     if (candidate.found) {
       candidate.association.point = p;
       candidate.association.distance_sq = std::max(0.0, candidate.best);

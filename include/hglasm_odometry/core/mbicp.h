@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "hglasm_odometry/core/bearing_bins.h"
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
 
@@ -134,13 +133,14 @@ class Mbicp {
   struct Candidate {
     double best = 0.0;
     bool found = false;
-    std::int64_t code = -1;  // the element: reference index * 2 + is_segment
     Association association;
   };
   void considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const;
   /// u_scale: 1 / (|p|^2 + L^2), the metric frozen at p.
   void considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double u_scale,
                        Candidate* candidate) const;
+  /// The best association of one point (its bearing walk).
+  void associatePoint(const Eigen::Vector2d& p, double gate_sq, Candidate* candidate);
   void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out);
   /// c^2 of the robust weights for the current associations (0: no weights).
   double robustScaleSq() const;
@@ -158,15 +158,16 @@ class Mbicp {
   double informationScale(double constraints) const;
 
   MbicpOptions options_;
-  std::vector<Eigen::Vector2d> ref_points_;    // in beam order
-  std::vector<std::int8_t> ref_has_next_;      // segment from point i to i+1
-  std::vector<Eigen::Vector2d> ref_normals_;   // unit surface normal at each point (zero if isolated)
-  std::vector<Eigen::Vector2d> ref_tangents_;  // unit direction across each point's beam
-  std::vector<double> ref_sampling_variance_;  // (range * angular spacing)^2 / 12 of each point
-  BearingBins bins_;                           // the points and segments by bearing
-  /// Per point of the last association: its element (a first candidate for the next iteration's search,
-  /// which then only has to look where something closer may lie), -1 if none.
-  std::vector<std::int64_t> last_element_;
+  std::vector<Eigen::Vector2d> ref_points_;        // in beam order
+  std::vector<std::int8_t> ref_has_next_;          // segment from point i to i+1
+  std::vector<Eigen::Vector2d> ref_normals_;       // unit surface normal at each point (zero if isolated)
+  std::vector<Eigen::Vector2d> ref_tangents_;      // unit direction across each point's beam
+  std::vector<double> ref_sampling_variance_;      // (range * angular spacing)^2 / 12 of each point
+  std::vector<double> sorted_bearing_;             // bearings of reference points, ascending
+  std::vector<int> sorted_index_;                  // their indices into ref_points_
+  std::vector<double> ref_metric_scale_;           // |q|^2 + L^2 of each point (d_ap's denominator)
+  std::vector<std::uint32_t> segment_seen_;        // per segment: the last point whose walk considered it
+  std::uint32_t walk_id_ = 0;
   std::vector<Association> associations_;                       // scratch
   Eigen::Matrix3d scan_information_ = Eigen::Matrix3d::Zero();  // of the last step, increment coordinates
   std::vector<Eigen::Vector2d> moved_;                          // scratch
