@@ -110,6 +110,14 @@ void Mbicp::setReference(const ReferencePoints& reference) {
             [&](int a, int b) { return bearing[a] < bearing[b]; });
   sorted_bearing_.resize(n);
   for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
+  // Where each of n equal bearing buckets starts in sorted_bearing_.
+  bucket_first_.resize(n + 1);
+  for (std::size_t b = 0; b <= n; ++b) {
+    const double edge =
+        -M_PI + 2.0 * M_PI * static_cast<double>(b) / static_cast<double>(std::max<std::size_t>(n, 1));
+    bucket_first_[b] = static_cast<int>(
+        std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), edge) - sorted_bearing_.begin());
+  }
   const double l_sq = options_.metric_l * options_.metric_l;
   ref_metric_scale_.resize(n);
   for (std::size_t i = 0; i < n; ++i) ref_metric_scale_[i] = ref_points_[i].squaredNorm() + l_sq;
@@ -179,6 +187,21 @@ void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double
   }
 }
 
+int Mbicp::walkStart(double bearing) const {
+  // std::lower_bound() of the bearing, from its bucket's first point (a step or two, not a search).
+  const int n = static_cast<int>(sorted_bearing_.size());
+  const int buckets = static_cast<int>(bucket_first_.size()) - 1;
+  if (!(buckets > 0) || !(bearing == bearing)) {
+    return static_cast<int>(std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), bearing) -
+                            sorted_bearing_.begin());
+  }
+  const double position = (bearing + M_PI) * (buckets / (2.0 * M_PI));
+  int k = bucket_first_[std::clamp(static_cast<int>(position), 0, buckets - 1)];
+  while (k > 0 && sorted_bearing_[k - 1] >= bearing) --k;
+  while (k < n && sorted_bearing_[k] < bearing) ++k;
+  return k;
+}
+
 void Mbicp::associatePoint(const Eigen::Vector2d& p, double gate_sq, Candidate* candidate) {
   const double l_sq = options_.metric_l * options_.metric_l;
   const double window = std::min(options_.bearing_window, M_PI);
@@ -196,8 +219,7 @@ void Mbicp::associatePoint(const Eigen::Vector2d& p, double gate_sq, Candidate* 
   const double bearing = std::atan2(p.y(), p.x());
   const double range = p.norm();
   const int n = static_cast<int>(sorted_bearing_.size());
-  const int start = static_cast<int>(
-      std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), bearing) - sorted_bearing_.begin());
+  const int start = walkStart(bearing);
   double reach = window;
   double reach_best = -1.0;
   auto update_reach = [&]() {

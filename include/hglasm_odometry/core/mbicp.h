@@ -141,6 +141,8 @@ class Mbicp {
                        Candidate* candidate) const;
   /// The best association of one point (its bearing walk).
   void associatePoint(const Eigen::Vector2d& p, double gate_sq, Candidate* candidate);
+  /// The first index of sorted_bearing_ not below `bearing` (std::lower_bound).
+  int walkStart(double bearing) const;
   void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out);
   /// c^2 of the robust weights for the current associations (0: no weights).
   double robustScaleSq() const;
@@ -158,15 +160,16 @@ class Mbicp {
   double informationScale(double constraints) const;
 
   MbicpOptions options_;
-  std::vector<Eigen::Vector2d> ref_points_;        // in beam order
-  std::vector<std::int8_t> ref_has_next_;          // segment from point i to i+1
-  std::vector<Eigen::Vector2d> ref_normals_;       // unit surface normal at each point (zero if isolated)
-  std::vector<Eigen::Vector2d> ref_tangents_;      // unit direction across each point's beam
-  std::vector<double> ref_sampling_variance_;      // (range * angular spacing)^2 / 12 of each point
-  std::vector<double> sorted_bearing_;             // bearings of reference points, ascending
-  std::vector<int> sorted_index_;                  // their indices into ref_points_
-  std::vector<double> ref_metric_scale_;           // |q|^2 + L^2 of each point (d_ap's denominator)
-  std::vector<std::uint32_t> segment_seen_;        // per segment: the last point whose walk considered it
+  std::vector<Eigen::Vector2d> ref_points_;    // in beam order
+  std::vector<std::int8_t> ref_has_next_;      // segment from point i to i+1
+  std::vector<Eigen::Vector2d> ref_normals_;   // unit surface normal at each point (zero if isolated)
+  std::vector<Eigen::Vector2d> ref_tangents_;  // unit direction across each point's beam
+  std::vector<double> ref_sampling_variance_;  // (range * angular spacing)^2 / 12 of each point
+  std::vector<double> sorted_bearing_;         // bearings of reference points, ascending
+  std::vector<int> sorted_index_;              // their indices into ref_points_
+  std::vector<int> bucket_first_;  // first sorted index of each of n equal bearing buckets (n + 1 entries)
+  std::vector<double> ref_metric_scale_;     // |q|^2 + L^2 of each point (d_ap's denominator)
+  std::vector<std::uint32_t> segment_seen_;  // per segment: the last point whose walk considered it
   std::uint32_t walk_id_ = 0;
   std::vector<Association> associations_;                       // scratch
   Eigen::Matrix3d scan_information_ = Eigen::Matrix3d::Zero();  // of the last step, increment coordinates
