@@ -2,8 +2,50 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace hglasm {
+namespace {
+
+constexpr long kChunk = 16;
+
+/// Byte masks: kLeadingBytes[n] has its first n bytes set.
+struct LeadingBytes {
+  std::uint8_t mask[kChunk + 1][kChunk];
+  constexpr LeadingBytes() : mask() {
+    for (long n = 0; n <= kChunk; ++n) {
+      for (long i = 0; i < kChunk; ++i) mask[n][i] = i < n ? 0xFF : 0x00;
+    }
+  }
+};
+constexpr LeadingBytes kLeadingBytes;
+
+/// target[i] = max(target[i], values[i] & mask[i]) for i < kChunk, one operation the compiler vectorises.
+inline void maxChunk(std::uint8_t* target, const std::uint8_t* values, const std::uint8_t* mask) {
+  std::uint8_t chunk[kChunk], add[kChunk];
+  std::memcpy(chunk, target, kChunk);
+  std::memcpy(add, values, kChunk);
+  for (long i = 0; i < kChunk; ++i)
+    chunk[i] = std::max(chunk[i], static_cast<std::uint8_t>(add[i] & mask[i]));
+  std::memcpy(target, chunk, kChunk);
+}
+
+/// target[i] = max(target[i], values[i]) for i < count, in chunks: the bytes of the last chunk past
+/// `count` are maxed with zero, which leaves them as they are (both arrays must be readable and writable
+/// that far). A stamp's bytes past its row's end are zeros, or in the next row or tile (left unchanged).
+inline void maxInto(std::uint8_t* target, const std::uint8_t* values, long count) {
+  for (; count > 0; count -= kChunk, target += kChunk, values += kChunk) {
+    maxChunk(target, values, kLeadingBytes.mask[std::min(count, kChunk)]);
+  }
+}
+
+/// floor() for the table's coordinates (|value| far below 2^62), without a library call.
+inline long floorToLong(double value) {
+  const long truncated = static_cast<long>(value);
+  return value < static_cast<double>(truncated) ? truncated - 1 : truncated;
+}
+
+}  // namespace
 
 LookupTable::LookupTable(const LookupTableOptions& options) : options_(options) {
   // Guard against nonsense sizes here too; the ROS layer validates and names the parameter.
@@ -21,7 +63,9 @@ void LookupTable::buildKernel() {
   const double reach = options_.kind == TableKind::kGraded ? options_.cutoff : options_.sigma;
   kernel_radius_ = static_cast<int>(std::ceil(reach * inv_cell_size_ - 1e-9));
   const int side = 2 * kernel_radius_ + 1;
-  kernel_.assign(static_cast<std::size_t>(side) * side, 0);
+  // Rows padded with zeros (and the last one followed by zeros) for the stamps' 16-byte reads.
+  kernel_stride_ = side + kChunk;
+  kernel_.assign(static_cast<std::size_t>(kernel_stride_) * side + kChunk, 0);
   const double inv_two_sigma_sq = 1.0 / (2.0 * options_.sigma * options_.sigma);
   for (int dy = -kernel_radius_; dy <= kernel_radius_; ++dy) {
     for (int dx = -kernel_radius_; dx <= kernel_radius_; ++dx) {
@@ -35,12 +79,12 @@ void LookupTable::buildKernel() {
       } else {
         value = 1;  // the whole square
       }
-      kernel_[(dy + kernel_radius_) * side + dx + kernel_radius_] = value;
+      kernel_[(dy + kernel_radius_) * kernel_stride_ + dx + kernel_radius_] = value;
     }
   }
   kernel_spans_.assign(static_cast<std::size_t>(side), {0, 0});
   for (int row = 0; row < side; ++row) {
-    const std::uint8_t* values = &kernel_[static_cast<std::size_t>(row) * side];
+    const std::uint8_t* values = &kernel_[static_cast<std::size_t>(row) * kernel_stride_];
     int first = 0, last = side;
     while (first < side && values[first] == 0) ++first;
     while (last > first && values[last - 1] == 0) --last;
@@ -114,8 +158,10 @@ bool LookupTable::collectCells(const ReferencePoints& reference_set, Box* box) {
   cells_.clear();
   for (const auto& p : samples_) {
     if (std::abs(p.x()) > kMaxCoordinate || std::abs(p.y()) > kMaxCoordinate) continue;
-    const long cx = static_cast<long>(std::floor(p.x() * inv_cell_size_));
-    const long cy = static_cast<long>(std::floor(p.y() * inv_cell_size_));
+    const long cx = floorToLong(p.x() * inv_cell_size_);
+    const long cy = floorToLong(p.y() * inv_cell_size_);
+    // Samples along a surface fall into the same cell in a row: one entry each run.
+    if (!cells_.empty() && cells_.back().first == cx && cells_.back().second == cy) continue;
     if (cells_.empty()) {
       box->min_x = box->max_x = cx;
       box->min_y = box->max_y = cy;
@@ -158,7 +204,8 @@ void LookupTable::allocateTiles(const Box& box) {
   for (std::int32_t& offset : tile_offset_) {
     if (offset < 0) offset = zero_tile;
   }
-  tile_cells_.assign((tiles_in_use_ + 1) * kTileCells, 0);
+  // A stamp's last 16-byte maximum may reach past the last tile (with zeros: it changes nothing there).
+  tile_cells_.assign((tiles_in_use_ + 1) * kTileCells + kChunk, 0);
 }
 
 void LookupTable::build(const ReferencePoints& reference_set) {
@@ -173,32 +220,65 @@ void LookupTable::build(const ReferencePoints& reference_set) {
   // depends on the centre's cell only: overlapping keyframes and close samples put many in one cell, which
   // is stamped once.
   stamped_.assign(tiles_in_use_ * kTileCells, 0);
-  const long r = kernel_radius_;
-  const long side = 2 * r + 1;
   for (const auto& cell : cells_) {
     const long cx = cell.first - origin_cell_x_, cy = cell.second - origin_cell_y_;
     std::uint8_t& centre = stamped_[cellOffset(cx, cy)];
     if (centre) continue;
     centre = 1;
-    const long lx0 = cx - r;
-    const long ly0 = cy - r;
-    for (long ky = 0; ky < side; ++ky) {
-      const long ly = ly0 + ky;
-      const std::int32_t* offset_row = &tile_offset_[tileSlot(0, ly, stride_shift_)];
-      const std::uint8_t* kernel_row = &kernel_[ky * side];
-      const long cell_row = (ly & (kTileSize - 1)) << kTileShift;
-      // The row's non-zero span, in runs that stay within one tile: contiguous bytes the compiler
-      // vectorises.
-      const long end = kernel_spans_[ky].second;
-      for (long kx = kernel_spans_[ky].first; kx < end;) {
-        const long lx = lx0 + kx;
-        const long in_tile = lx & (kTileSize - 1);
-        const long run = std::min(end - kx, kTileSize - in_tile);
-        std::uint8_t* target = &tile_cells_[offset_row[lx >> kTileShift] + cell_row + in_tile];
-        const std::uint8_t* value = kernel_row + kx;
-        for (long i = 0; i < run; ++i) target[i] = std::max(target[i], value[i]);
-        kx += run;
+    stamp(cx, cy);
+  }
+}
+
+void LookupTable::stamp(long cx, long cy) {
+  const long r = kernel_radius_;
+  const long side = 2 * r + 1;
+  const long x0 = cx - r, y0 = cy - r;  // the stamp's first column and row
+  // A tile is wider than a stamp: its columns cross at most one tile edge, at kernel column `split`, and
+  // its rows at most one, at kernel row `split_row`.
+  const long tile_x = x0 >> kTileShift, in_tile_x = x0 & (kTileSize - 1);
+  const long split = kTileSize - in_tile_x;
+  const long split_row = kTileSize - (y0 & (kTileSize - 1));
+  const std::int32_t* upper = &tile_offset_[tileSlot(0, y0, stride_shift_)];
+  const std::int32_t* lower = &tile_offset_[tileSlot(0, y0 + kTileSize, stride_shift_)];
+  // Each side's cell of the stamp's first row (kernel row 0) in the upper tiles and, shifted back by
+  // split_row rows, in the lower ones: the cell of kernel row ky is then base + ky * kTileSize.
+  std::uint8_t* cells = tile_cells_.data();
+  const long first_row = (y0 & (kTileSize - 1)) << kTileShift;
+  std::uint8_t* upper_left = cells + upper[tile_x] + first_row + in_tile_x;
+  std::uint8_t* upper_right = cells + upper[tile_x + 1] + first_row - split;
+  std::uint8_t* lower_left = cells + lower[tile_x] - split_row * kTileSize + in_tile_x;
+  std::uint8_t* lower_right = cells + lower[tile_x + 1] - split_row * kTileSize - split;
+  const long rows_up = std::min(side, split_row);
+  stampRows(0, rows_up, split, upper_left, upper_right);
+  stampRows(rows_up, side, split, lower_left, lower_right);
+}
+
+void LookupTable::stampRows(long begin, long end, long split, std::uint8_t* left, std::uint8_t* right) {
+  // Locals, not members: the byte stores below may alias anything, so members would be reloaded per row.
+  const std::uint8_t* kernel = kernel_.data();
+  const long kernel_stride = kernel_stride_;
+  const std::pair<long, long>* spans = kernel_spans_.data();
+  const bool narrow = 2 * kernel_radius_ + 1 <= kChunk;  // a row in one chunk (the defaults: 15 of 17)
+  const std::uint8_t* all = kLeadingBytes.mask[kChunk];
+  for (long ky = begin; ky < end; ++ky) {
+    std::uint8_t* row_left = left + ky * kTileSize;
+    std::uint8_t* row_right = right + ky * kTileSize;
+    const std::uint8_t* kernel_row = kernel + ky * kernel_stride;
+    const long first = spans[ky].first, last = spans[ky].second;
+    if (narrow) {
+      // One chunk on each side of the edge: masked before it; past the span the kernel row is zero.
+      if (last <= split) {
+        maxChunk(row_left + first, kernel_row + first, all);
+      } else if (first >= split) {
+        maxChunk(row_right + first, kernel_row + first, all);
+      } else {
+        maxChunk(row_left + first, kernel_row + first, kLeadingBytes.mask[split - first]);
+        maxChunk(row_right + split, kernel_row + split, all);
       }
+    } else {
+      maxInto(row_left + first, kernel_row + first, std::min(last, split) - first);
+      const long right_first = std::max(first, split);
+      maxInto(row_right + right_first, kernel_row + right_first, last - right_first);
     }
   }
 }

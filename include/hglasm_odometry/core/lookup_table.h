@@ -106,6 +106,11 @@ class LookupTable {
   /// The stamp centres' global cells (cells_) and their bounding box; false if there is none.
   bool collectCells(const ReferencePoints& reference, Box* box);
   void allocateTiles(const Box& box);
+  /// Maxes the kernel into the cells around table cell (cx, cy).
+  void stamp(long cx, long cy);
+  /// Kernel rows [begin, end) of a stamp: kernel column c goes to left[ky * kTileSize + c] before column
+  /// `split` (a tile edge), to right[ky * kTileSize + c] from it on.
+  void stampRows(long begin, long end, long split, std::uint8_t* left, std::uint8_t* right);
   /// tile_offset_'s entry of the tile holding table cell (x, y), x and y >= -kTileSize (the ring).
   static long tileSlot(long x, long y, int stride_shift) {
     return (((y >> kTileShift) + 1) << stride_shift) + (x >> kTileShift) + 1;
@@ -169,10 +174,11 @@ class LookupTable {
   int stride_shift_ = 0;
   std::vector<std::uint8_t> tile_cells_;  // (tiles_in_use_ + 1) * kTileCells, the zero tile last
   std::size_t tiles_in_use_ = 0;
-  std::vector<Eigen::Vector2d> samples_;             // scratch: stamp centres
-  std::vector<std::pair<long, long>> cells_;         // scratch: their global cells
-  std::vector<std::uint8_t> stamped_;                // scratch: 1 where a stamp is centred (as tile_cells_)
-  std::vector<std::uint8_t> kernel_;                 // (2r+1)^2 stamp, r = ceil(cutoff / cell_size)
+  std::vector<Eigen::Vector2d> samples_;      // scratch: stamp centres
+  std::vector<std::pair<long, long>> cells_;  // scratch: their global cells
+  std::vector<std::uint8_t> stamped_;         // scratch: 1 where a stamp is centred (as tile_cells_)
+  std::vector<std::uint8_t> kernel_;  // (2r+1) rows of kernel_stride_ bytes, r = ceil(cutoff / cell_size)
+  long kernel_stride_ = 0;
   std::vector<std::pair<long, long>> kernel_spans_;  // per kernel row: [first, last) non-zero columns
   int kernel_radius_ = 0;
 };
