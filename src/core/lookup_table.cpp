@@ -90,13 +90,18 @@ void LookupTable::buildKernel() {
     while (last > first && values[last - 1] == 0) --last;
     kernel_spans_[row] = {first, last};
   }
+  kernel_rows_ = {0, side};
+  while (kernel_rows_.first < side && kernel_spans_[kernel_rows_.first].first == side) ++kernel_rows_.first;
+  while (kernel_rows_.second > kernel_rows_.first && kernel_spans_[kernel_rows_.second - 1].first == side) {
+    --kernel_rows_.second;
+  }
 }
 
 std::uint32_t LookupTable::maxCellValue() const { return options_.kind == TableKind::kGraded ? 255u : 1u; }
 
 std::size_t LookupTable::memoryBytes() const {
-  return tile_offset_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() + stamped_.capacity() +
-         kernel_.capacity();
+  return tile_offset_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() +
+         stamped_.capacity() * sizeof(std::uint64_t) + kernel_.capacity();
 }
 
 void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
@@ -190,14 +195,27 @@ void LookupTable::allocateTiles(const Box& box) {
   stride_shift_ = 0;
   while ((1L << stride_shift_) < tiles_x_ + 2) ++stride_shift_;
   tile_offset_.assign(static_cast<std::size_t>((tiles_y_ + 2) << stride_shift_), -1);
+  // A stamp spans at most two tiles each way (a tile is wider than a stamp).
+  std::int32_t* offsets = tile_offset_.data();
+  const auto allocate = [&](long tile_x, long tile_y) {
+    std::int32_t& offset = offsets[((tile_y + 1) << stride_shift_) + tile_x + 1];
+    if (offset < 0) offset = static_cast<std::int32_t>(tiles_in_use_++ * kTileCells);
+  };
   for (const auto& cell : cells_) {
-    const long lx0 = cell.first - r - origin_cell_x_, lx1 = cell.first + r - origin_cell_x_;
-    const long ly0 = cell.second - r - origin_cell_y_, ly1 = cell.second + r - origin_cell_y_;
-    for (long ty = ly0 >> kTileShift; ty <= (ly1 >> kTileShift); ++ty) {
-      for (long tx = lx0 >> kTileShift; tx <= (lx1 >> kTileShift); ++tx) {
-        std::int32_t& offset = tile_offset_[tileSlot(tx << kTileShift, ty << kTileShift, stride_shift_)];
-        if (offset < 0) offset = static_cast<std::int32_t>(tiles_in_use_++ * kTileCells);
+    const long x = cell.first - origin_cell_x_, y = cell.second - origin_cell_y_;
+    const long x0 = (x - r) >> kTileShift, x1 = (x + r) >> kTileShift;
+    const long y0 = (y - r) >> kTileShift, y1 = (y + r) >> kTileShift;
+    if (x1 - x0 > 1 || y1 - y0 > 1) {  // a kernel wider than a tile (not the presets')
+      for (long ty = y0; ty <= y1; ++ty) {
+        for (long tx = x0; tx <= x1; ++tx) allocate(tx, ty);
       }
+      continue;
+    }
+    allocate(x0, y0);
+    if (x1 != x0) allocate(x1, y0);
+    if (y1 != y0) {
+      allocate(x0, y1);
+      if (x1 != x0) allocate(x1, y1);
     }
   }
   const auto zero_tile = static_cast<std::int32_t>(tiles_in_use_ * kTileCells);
@@ -219,19 +237,24 @@ void LookupTable::build(const ReferencePoints& reference_set) {
   // Stamp the kernel around each point, keeping the maximum (likelihood of the nearest point). A stamp
   // depends on the centre's cell only: overlapping keyframes and close samples put many in one cell, which
   // is stamped once.
-  stamped_.assign(tiles_in_use_ * kTileCells, 0);
+  stamped_.assign(tiles_in_use_ * kTileCells / 64, 0);
   for (const auto& cell : cells_) {
     const long cx = cell.first - origin_cell_x_, cy = cell.second - origin_cell_y_;
-    std::uint8_t& centre = stamped_[cellOffset(cx, cy)];
-    if (centre) continue;
-    centre = 1;
+    const std::size_t offset = cellOffset(cx, cy);
+    std::uint64_t& word = stamped_[offset / 64];
+    const std::uint64_t bit = std::uint64_t{1} << (offset % 64);
+    if (word & bit) continue;
+    word |= bit;
     stamp(cx, cy);
   }
 }
 
 void LookupTable::stamp(long cx, long cy) {
   const long r = kernel_radius_;
-  const long side = 2 * r + 1;
+  if (2 * r + 1 > kTileSize) {
+    stampWide(cx, cy);
+    return;
+  }
   const long x0 = cx - r, y0 = cy - r;  // the stamp's first column and row
   // A tile is wider than a stamp: its columns cross at most one tile edge, at kernel column `split`, and
   // its rows at most one, at kernel row `split_row`.
@@ -248,9 +271,29 @@ void LookupTable::stamp(long cx, long cy) {
   std::uint8_t* upper_right = cells + upper[tile_x + 1] + first_row - split;
   std::uint8_t* lower_left = cells + lower[tile_x] - split_row * kTileSize + in_tile_x;
   std::uint8_t* lower_right = cells + lower[tile_x + 1] - split_row * kTileSize - split;
-  const long rows_up = std::min(side, split_row);
-  stampRows(0, rows_up, split, upper_left, upper_right);
-  stampRows(rows_up, side, split, lower_left, lower_right);
+  // Only the kernel's non-zero rows (a round kernel leaves the square's outer rows empty).
+  const long rows_up = std::clamp(split_row, kernel_rows_.first, kernel_rows_.second);
+  stampRows(kernel_rows_.first, rows_up, split, upper_left, upper_right);
+  stampRows(rows_up, kernel_rows_.second, split, lower_left, lower_right);
+}
+
+void LookupTable::stampWide(long cx, long cy) {
+  // A kernel wider than a tile (not the presets'): each row in runs that stay within one tile.
+  const long r = kernel_radius_;
+  for (long ky = kernel_rows_.first; ky < kernel_rows_.second; ++ky) {
+    const long ly = cy - r + ky;
+    const std::int32_t* offsets = &tile_offset_[tileSlot(0, ly, stride_shift_)];
+    const long row = (ly & (kTileSize - 1)) << kTileShift;
+    const long end = kernel_spans_[ky].second;
+    for (long kx = kernel_spans_[ky].first; kx < end;) {
+      const long lx = cx - r + kx;
+      const long in_tile = lx & (kTileSize - 1);
+      const long run = std::min(end - kx, kTileSize - in_tile);
+      maxInto(&tile_cells_[offsets[lx >> kTileShift] + row + in_tile], &kernel_[ky * kernel_stride_ + kx],
+              run);
+      kx += run;
+    }
+  }
 }
 
 void LookupTable::stampRows(long begin, long end, long split, std::uint8_t* left, std::uint8_t* right) {

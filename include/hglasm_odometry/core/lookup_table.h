@@ -108,6 +108,7 @@ class LookupTable {
   void allocateTiles(const Box& box);
   /// Maxes the kernel into the cells around table cell (cx, cy).
   void stamp(long cx, long cy);
+  void stampWide(long cx, long cy);  // the same for a kernel wider than a tile
   /// Kernel rows [begin, end) of a stamp: kernel column c goes to left[ky * kTileSize + c] before column
   /// `split` (a tile edge), to right[ky * kTileSize + c] from it on.
   void stampRows(long begin, long end, long split, std::uint8_t* left, std::uint8_t* right);
@@ -115,7 +116,8 @@ class LookupTable {
   static long tileSlot(long x, long y, int stride_shift) {
     return (((y >> kTileShift) + 1) << stride_shift) + (x >> kTileShift) + 1;
   }
-  /// Index into tile_cells_ (or stamped_) of the cell at table coordinates (x, y), x and y >= -kTileSize.
+  /// Index into tile_cells_ (or stamped_'s bits) of the cell at table coordinates (x, y), x and y >=
+  /// -kTileSize.
   std::size_t cellOffset(long x, long y) const {
     return static_cast<std::size_t>(tile_offset_[tileSlot(x, y, stride_shift_)]) +
            static_cast<std::size_t>(((y & (kTileSize - 1)) << kTileShift) + (x & (kTileSize - 1)));
@@ -176,10 +178,12 @@ class LookupTable {
   std::size_t tiles_in_use_ = 0;
   std::vector<Eigen::Vector2d> samples_;      // scratch: stamp centres
   std::vector<std::pair<long, long>> cells_;  // scratch: their global cells
-  std::vector<std::uint8_t> stamped_;         // scratch: 1 where a stamp is centred (as tile_cells_)
+  std::vector<std::uint64_t>
+      stamped_;                       // scratch: a bit per cell of tile_cells_, set where a stamp is centred
   std::vector<std::uint8_t> kernel_;  // (2r+1) rows of kernel_stride_ bytes, r = ceil(cutoff / cell_size)
   long kernel_stride_ = 0;
   std::vector<std::pair<long, long>> kernel_spans_;  // per kernel row: [first, last) non-zero columns
+  std::pair<long, long> kernel_rows_;                // [first, last) rows with a non-zero column
   int kernel_radius_ = 0;
 };
 
