@@ -143,26 +143,22 @@ void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
   }
 }
 
-void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double, Candidate* candidate) const {
+inline void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double, Candidate* candidate) const {
   // dapSquared() with the point's |q|^2 + L^2 precomputed.
   const Eigen::Vector2d& q = ref_points_[j];
   const Eigen::Vector2d d = p - q;
   const double cross = d.x() * q.y() - d.y() * q.x();
   const double d_sq = d.squaredNorm() - cross * cross / ref_metric_scale_[j];
   if (d_sq < candidate->best) {
-    candidate->best = d_sq, candidate->found = true;
-    Association& association = candidate->association;
-    association.target = ref_points_[j];
-    association.normal = ref_normals_[j];
-    association.on_segment = false;
-    const bool isolated = ref_normals_[j].isZero();
-    association.sampling_tangent = isolated ? ref_tangents_[j] : Eigen::Vector2d::Zero();
-    association.sampling_variance = isolated ? ref_sampling_variance_[j] : 0.0;
+    candidate->best = d_sq;
+    candidate->element = j;
+    candidate->segment = false;
+    candidate->target = q;
   }
 }
 
-void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double u_scale,
-                            Candidate* candidate) const {
+inline void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double u_scale,
+                                   Candidate* candidate) const {
   // Closest point of segment j -> j+1 under the metric, with the metric frozen at p (it varies slowly):
   // minimise (a - t e)^T M (a - t e), M = I - u u^T / (|p|^2 + L^2), u = (p_y, -p_x).
   const Eigen::Vector2d u(p.y(), -p.x());
@@ -177,14 +173,26 @@ void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double
   const Eigen::Vector2d on_segment = q + t * e;
   const double d_sq = dapSquared(p, on_segment, l_sq);
   if (d_sq < candidate->best) {
-    candidate->best = d_sq, candidate->found = true;
-    Association& association = candidate->association;
-    association.target = on_segment;
-    association.normal = unitNormal(e);
-    association.on_segment = true;
-    association.sampling_tangent = Eigen::Vector2d::Zero();
-    association.sampling_variance = 0.0;
+    candidate->best = d_sq;
+    candidate->element = j;
+    candidate->segment = true;
+    candidate->target = on_segment;
   }
+}
+
+Mbicp::Association Mbicp::associationOf(const Eigen::Vector2d& p, const Candidate& candidate) const {
+  const int j = candidate.element;
+  Association association;
+  association.point = p;
+  association.target = candidate.target;
+  association.on_segment = candidate.segment;
+  association.distance_sq = std::max(0.0, candidate.best);
+  association.weight = 1.0;
+  const bool isolated = !candidate.segment && ref_normals_[j].isZero();
+  association.normal = candidate.segment ? unitNormal(ref_points_[j + 1] - ref_points_[j]) : ref_normals_[j];
+  association.sampling_tangent = isolated ? ref_tangents_[j] : Eigen::Vector2d::Zero();
+  association.sampling_variance = isolated ? ref_sampling_variance_[j] : 0.0;
+  return association;
 }
 
 int Mbicp::walkStart(double bearing) const {
@@ -268,12 +276,7 @@ void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, st
   for (const auto& p : moved) {
     Candidate candidate;
     associatePoint(p, gate * gate, &candidate);
-    if (candidate.found) {
-      candidate.association.point = p;
-      candidate.association.distance_sq = std::max(0.0, candidate.best);
-      candidate.association.weight = 1.0;
-      out->push_back(candidate.association);
-    }
+    if (candidate.element >= 0) out->push_back(associationOf(p, candidate));
   }
 }
 

@@ -132,9 +132,12 @@ class Mbicp {
   /// The best association of one point so far (d_ap^2 below `best`).
   struct Candidate {
     double best = 0.0;
-    bool found = false;
-    Association association;
+    int element = -1;  // reference point, or segment from it to the next; -1: none yet
+    bool segment = false;
+    Eigen::Vector2d target;  // the point on the element
   };
+  /// The association of p with its candidate's element.
+  Association associationOf(const Eigen::Vector2d& p, const Candidate& candidate) const;
   void considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const;
   /// u_scale: 1 / (|p|^2 + L^2), the metric frozen at p.
   void considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double u_scale,
