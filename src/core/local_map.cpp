@@ -79,6 +79,7 @@ void LocalMap::refresh() {
   reference_.points.reserve(points.size());
   for (const Eigen::Vector2d& point : points.points) reference_.points.push_back(to_frame * point);
   reference_.scan_starts = points.scan_starts;
+  reference_.scan_steps = points.scan_steps;  // angles between beams: the same in any frame
   for (const Eigen::Vector2d& origin : points.scan_origins)
     reference_.scan_origins.push_back(to_frame * origin);
   const Pose2D query_in_table = to_frame.inverse();

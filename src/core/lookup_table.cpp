@@ -2,8 +2,50 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace hglasm {
+namespace {
+
+constexpr long kChunk = 16;
+
+/// Byte masks: kLeadingBytes[n] has its first n bytes set.
+struct LeadingBytes {
+  std::uint8_t mask[kChunk + 1][kChunk];
+  constexpr LeadingBytes() : mask() {
+    for (long n = 0; n <= kChunk; ++n) {
+      for (long i = 0; i < kChunk; ++i) mask[n][i] = i < n ? 0xFF : 0x00;
+    }
+  }
+};
+constexpr LeadingBytes kLeadingBytes;
+
+/// target[i] = max(target[i], values[i] & mask[i]) for i < kChunk, one operation the compiler vectorises.
+inline void maxChunk(std::uint8_t* target, const std::uint8_t* values, const std::uint8_t* mask) {
+  std::uint8_t chunk[kChunk], add[kChunk];
+  std::memcpy(chunk, target, kChunk);
+  std::memcpy(add, values, kChunk);
+  for (long i = 0; i < kChunk; ++i)
+    chunk[i] = std::max(chunk[i], static_cast<std::uint8_t>(add[i] & mask[i]));
+  std::memcpy(target, chunk, kChunk);
+}
+
+/// target[i] = max(target[i], values[i]) for i < count, in chunks: the bytes of the last chunk past
+/// `count` are maxed with zero, which leaves them as they are (both arrays must be readable and writable
+/// that far). A stamp's bytes past its row's end are zeros, or in the next row or tile (left unchanged).
+inline void maxInto(std::uint8_t* target, const std::uint8_t* values, long count) {
+  for (; count > 0; count -= kChunk, target += kChunk, values += kChunk) {
+    maxChunk(target, values, kLeadingBytes.mask[std::min(count, kChunk)]);
+  }
+}
+
+/// floor() for the table's coordinates (|value| far below 2^62), without a library call.
+inline long floorToLong(double value) {
+  const long truncated = static_cast<long>(value);
+  return value < static_cast<double>(truncated) ? truncated - 1 : truncated;
+}
+
+}  // namespace
 
 LookupTable::LookupTable(const LookupTableOptions& options) : options_(options) {
   // Guard against nonsense sizes here too; the ROS layer validates and names the parameter.
@@ -21,7 +63,9 @@ void LookupTable::buildKernel() {
   const double reach = options_.kind == TableKind::kGraded ? options_.cutoff : options_.sigma;
   kernel_radius_ = static_cast<int>(std::ceil(reach * inv_cell_size_ - 1e-9));
   const int side = 2 * kernel_radius_ + 1;
-  kernel_.assign(static_cast<std::size_t>(side) * side, 0);
+  // Rows padded with zeros (and the last one followed by zeros) for the stamps' 16-byte reads.
+  kernel_stride_ = side + kChunk;
+  kernel_.assign(static_cast<std::size_t>(kernel_stride_) * side + kChunk, 0);
   const double inv_two_sigma_sq = 1.0 / (2.0 * options_.sigma * options_.sigma);
   for (int dy = -kernel_radius_; dy <= kernel_radius_; ++dy) {
     for (int dx = -kernel_radius_; dx <= kernel_radius_; ++dx) {
@@ -35,24 +79,29 @@ void LookupTable::buildKernel() {
       } else {
         value = 1;  // the whole square
       }
-      kernel_[(dy + kernel_radius_) * side + dx + kernel_radius_] = value;
+      kernel_[(dy + kernel_radius_) * kernel_stride_ + dx + kernel_radius_] = value;
     }
   }
   kernel_spans_.assign(static_cast<std::size_t>(side), {0, 0});
   for (int row = 0; row < side; ++row) {
-    const std::uint8_t* values = &kernel_[static_cast<std::size_t>(row) * side];
+    const std::uint8_t* values = &kernel_[static_cast<std::size_t>(row) * kernel_stride_];
     int first = 0, last = side;
     while (first < side && values[first] == 0) ++first;
     while (last > first && values[last - 1] == 0) --last;
     kernel_spans_[row] = {first, last};
+  }
+  kernel_rows_ = {0, side};
+  while (kernel_rows_.first < side && kernel_spans_[kernel_rows_.first].first == side) ++kernel_rows_.first;
+  while (kernel_rows_.second > kernel_rows_.first && kernel_spans_[kernel_rows_.second - 1].first == side) {
+    --kernel_rows_.second;
   }
 }
 
 std::uint32_t LookupTable::maxCellValue() const { return options_.kind == TableKind::kGraded ? 255u : 1u; }
 
 std::size_t LookupTable::memoryBytes() const {
-  return tile_index_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() + stamped_.capacity() +
-         kernel_.capacity();
+  return tile_offset_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() +
+         stamped_.capacity() * sizeof(std::uint64_t) + kernel_.capacity();
 }
 
 void LookupTable::build(const std::vector<Eigen::Vector2d>& reference) {
@@ -109,11 +158,106 @@ void LookupTable::collectSamples(const ReferencePoints& reference_set) {
   if (options_.isolated_footprint > 0.0) stampFootprints(reference_set, joins, spacing);
 }
 
+bool LookupTable::collectCells(const ReferencePoints& reference_set, Box* box) {
+  collectSamples(reference_set);
+  cells_.clear();
+  for (const auto& p : samples_) {
+    if (std::abs(p.x()) > kMaxCoordinate || std::abs(p.y()) > kMaxCoordinate) continue;
+    const long cx = floorToLong(p.x() * inv_cell_size_);
+    const long cy = floorToLong(p.y() * inv_cell_size_);
+    // Samples along a surface fall into the same cell in a row: one entry each run.
+    if (!cells_.empty() && cells_.back().first == cx && cells_.back().second == cy) continue;
+    if (cells_.empty()) {
+      box->min_x = box->max_x = cx;
+      box->min_y = box->max_y = cy;
+    } else {
+      box->min_x = std::min(box->min_x, cx), box->max_x = std::max(box->max_x, cx);
+      box->min_y = std::min(box->min_y, cy), box->max_y = std::max(box->max_y, cy);
+    }
+    cells_.emplace_back(cx, cy);
+  }
+  return !cells_.empty();
+}
+
+LookupTable::Box LookupTable::tileRange(const Box& box) const {
+  const long r = kernel_radius_;
+  const auto floor_div = [](long a) {
+    return a >= 0 ? a >> kTileShift : -((-a + kTileSize - 1) >> kTileShift);
+  };
+  Box tiles;
+  tiles.min_x = floor_div(box.min_x - r), tiles.max_x = floor_div(box.max_x + r);
+  tiles.min_y = floor_div(box.min_y - r), tiles.max_y = floor_div(box.max_y + r);
+  return tiles;
+}
+
+void LookupTable::regrid(const Box& tiles) {
+  // The grid sits inside a ring of zero tiles (lookups clamped onto the ring read zero); its rows are a
+  // power of two wide. Tiles that have cells keep them: only their entries move.
+  const long old_first_x = origin_cell_x_ / kTileSize, old_first_y = origin_cell_y_ / kTileSize;
+  const int old_shift = stride_shift_;
+  const long old_tiles_x = tiles_x_, old_tiles_y = tiles_y_;
+  tiles_x_ = tiles.max_x - tiles.min_x + 1;
+  tiles_y_ = tiles.max_y - tiles.min_y + 1;
+  origin_cell_x_ = tiles.min_x * kTileSize;
+  origin_cell_y_ = tiles.min_y * kTileSize;
+  stride_shift_ = 0;
+  while ((1L << stride_shift_) < tiles_x_ + 2) ++stride_shift_;
+  std::vector<std::int32_t> offsets(static_cast<std::size_t>((tiles_y_ + 2) << stride_shift_), zero_tile_);
+  for (long ty = 0; ty < old_tiles_y; ++ty) {
+    for (long tx = 0; tx < old_tiles_x; ++tx) {
+      const long y = ty + old_first_y - tiles.min_y, x = tx + old_first_x - tiles.min_x;
+      offsets[((y + 1) << stride_shift_) + x + 1] = tile_offset_[((ty + 1) << old_shift) + tx + 1];
+    }
+  }
+  tile_offset_.swap(offsets);
+}
+
+void LookupTable::allocateTile(long slot) {
+  std::int32_t& offset = tile_offset_[slot];
+  if (offset != zero_tile_) return;
+  offset = static_cast<std::int32_t>(tile_slots_++ * kTileCells);
+  ++tiles_in_use_;
+}
+
+void LookupTable::allocateTiles(const Box& box) {
+  const Box tiles = tileRange(box);
+  if (tile_offset_.empty()) {
+    // The first tile of cells is the zero tile every tile without cells shares.
+    tile_slots_ = 1;
+    zero_tile_ = 0;
+    tiles_in_use_ = 0;
+    tiles_x_ = tiles_y_ = 0;
+    regrid(tiles);
+  } else {
+    const long first_x = origin_cell_x_ / kTileSize, first_y = origin_cell_y_ / kTileSize;
+    Box grown = tiles;
+    grown.min_x = std::min(grown.min_x, first_x), grown.max_x = std::max(grown.max_x, first_x + tiles_x_ - 1);
+    grown.min_y = std::min(grown.min_y, first_y), grown.max_y = std::max(grown.max_y, first_y + tiles_y_ - 1);
+    if (grown.min_x < first_x || grown.min_y < first_y || grown.max_x >= first_x + tiles_x_ ||
+        grown.max_y >= first_y + tiles_y_) {
+      regrid(grown);
+    }
+  }
+  // A stamp spans at most two tiles each way (a tile is wider than a stamp).
+  const long r = kernel_radius_;
+  for (const auto& cell : cells_) {
+    const long x = cell.first - origin_cell_x_, y = cell.second - origin_cell_y_;
+    const long x0 = (x - r) >> kTileShift, x1 = (x + r) >> kTileShift;
+    const long y0 = (y - r) >> kTileShift, y1 = (y + r) >> kTileShift;
+    for (long ty = y0; ty <= y1; ++ty) {
+      for (long tx = x0; tx <= x1; ++tx) allocateTile(((ty + 1) << stride_shift_) + tx + 1);
+    }
+  }
+  // A stamp's last 16-byte maximum may reach past the last tile (with zeros: it changes nothing there).
+  tile_cells_.resize(tile_slots_ * kTileCells + kChunk, 0);
+  stamped_.resize((tile_slots_ * kTileCells + 63) / 64, 0);
+}
+
 void LookupTable::clear() {
-  tiles_in_use_ = 0;
+  tiles_in_use_ = tile_slots_ = 0;
   tiles_x_ = tiles_y_ = 0;
   origin_cell_x_ = origin_cell_y_ = 0;
-  tile_index_.clear();
+  tile_offset_.clear();
   tile_cells_.clear();
   stamped_.clear();
 }
@@ -123,114 +267,97 @@ void LookupTable::build(const ReferencePoints& reference_set) {
   insert(reference_set);
 }
 
-namespace {
-
-/// The tile holding global cell `cell` (floor division by the tile size).
-long tileOf(long cell, int shift) {
-  const long size = 1L << shift;
-  return cell >= 0 ? cell >> shift : -((-cell + size - 1) >> shift);
-}
-
-}  // namespace
-
-void LookupTable::growGrid(long min_cx, long max_cx, long min_cy, long max_cy) {
-  long first_x = tileOf(min_cx, kTileShift), last_x = tileOf(max_cx, kTileShift);
-  long first_y = tileOf(min_cy, kTileShift), last_y = tileOf(max_cy, kTileShift);
-  const long old_first_x = origin_cell_x_ / kTileSize, old_first_y = origin_cell_y_ / kTileSize;
-  if (tiles_x_ > 0) {
-    if (first_x >= old_first_x && last_x < old_first_x + tiles_x_ && first_y >= old_first_y &&
-        last_y < old_first_y + tiles_y_) {
-      return;  // the grid already covers them
-    }
-    first_x = std::min(first_x, old_first_x), last_x = std::max(last_x, old_first_x + tiles_x_ - 1);
-    first_y = std::min(first_y, old_first_y), last_y = std::max(last_y, old_first_y + tiles_y_ - 1);
-  }
-  const long tiles_x = last_x - first_x + 1, tiles_y = last_y - first_y + 1;
-  std::vector<std::int32_t> index(static_cast<std::size_t>(tiles_x * tiles_y), -1);
-  for (long ty = 0; ty < tiles_y_; ++ty) {
-    std::copy_n(&tile_index_[ty * tiles_x_], tiles_x_,
-                &index[(ty + old_first_y - first_y) * tiles_x + (old_first_x - first_x)]);
-  }
-  tile_index_.swap(index);
-  tiles_x_ = tiles_x;
-  tiles_y_ = tiles_y;
-  origin_cell_x_ = first_x * kTileSize;
-  origin_cell_y_ = first_y * kTileSize;
-}
-
 void LookupTable::insert(const ReferencePoints& reference_set) {
-  // Global cell coordinates of the usable stamp centres, and their bounding box.
-  long min_cx = 0, max_cx = -1, min_cy = 0, max_cy = -1;
-  cells_.clear();
-  collectSamples(reference_set);
-  for (const auto& p : samples_) {
-    if (std::abs(p.x()) > kMaxCoordinate || std::abs(p.y()) > kMaxCoordinate) continue;
-    const long cx = static_cast<long>(std::floor(p.x() * inv_cell_size_));
-    const long cy = static_cast<long>(std::floor(p.y() * inv_cell_size_));
-    if (cells_.empty()) {
-      min_cx = max_cx = cx;
-      min_cy = max_cy = cy;
-    } else {
-      min_cx = std::min(min_cx, cx), max_cx = std::max(max_cx, cx);
-      min_cy = std::min(min_cy, cy), max_cy = std::max(max_cy, cy);
-    }
-    cells_.emplace_back(cx, cy);
-  }
-  if (cells_.empty()) return;
-
-  // Tile grid covering the box grown by the kernel radius; only touched tiles get cells.
-  const long r = kernel_radius_;
-  growGrid(min_cx - r, max_cx + r, min_cy - r, max_cy + r);
-  for (const auto& cell : cells_) {
-    const long lx0 = cell.first - r - origin_cell_x_, lx1 = cell.first + r - origin_cell_x_;
-    const long ly0 = cell.second - r - origin_cell_y_, ly1 = cell.second + r - origin_cell_y_;
-    for (long ty = ly0 >> kTileShift; ty <= (ly1 >> kTileShift); ++ty) {
-      for (long tx = lx0 >> kTileShift; tx <= (lx1 >> kTileShift); ++tx) {
-        std::int32_t& index = tile_index_[ty * tiles_x_ + tx];
-        if (index < 0) index = static_cast<std::int32_t>(tiles_in_use_++);
-      }
-    }
-  }
-  tile_cells_.resize(tiles_in_use_ * kTileCells, 0);
-  stamped_.resize(tiles_in_use_ * kTileCells, 0);
-  stampCells();
-}
-
-void LookupTable::stampCells() {
-  // Stamp the kernel around each centre, keeping the maximum (likelihood of the nearest point). A stamp
+  Box box;
+  if (!collectCells(reference_set, &box)) return;
+  allocateTiles(box);
+  // Stamp the kernel around each point, keeping the maximum (likelihood of the nearest point). A stamp
   // depends on the centre's cell only: overlapping keyframes and close samples put many in one cell, which
-  // is stamped once, and stamping in any order gives the same table.
-  const long r = kernel_radius_;
-  const long side = 2 * r + 1;
+  // is stamped once, in any order.
   for (const auto& cell : cells_) {
     const long cx = cell.first - origin_cell_x_, cy = cell.second - origin_cell_y_;
-    std::uint8_t& centre =
-        stamped_[static_cast<std::size_t>(tile_index_[(cy >> kTileShift) * tiles_x_ + (cx >> kTileShift)]) *
-                     kTileCells +
-                 ((cy & (kTileSize - 1)) << kTileShift) + (cx & (kTileSize - 1))];
-    if (centre) continue;
-    centre = 1;
-    const long lx0 = cx - r;
-    const long ly0 = cy - r;
-    for (long ky = 0; ky < side; ++ky) {
-      const long ly = ly0 + ky;
-      const std::int32_t* index_row = &tile_index_[(ly >> kTileShift) * tiles_x_];
-      const std::uint8_t* kernel_row = &kernel_[ky * side];
-      const long cell_row = (ly & (kTileSize - 1)) << kTileShift;
-      // The row's non-zero span, in runs that stay within one tile: contiguous bytes the compiler
-      // vectorises.
-      const long end = kernel_spans_[ky].second;
-      for (long kx = kernel_spans_[ky].first; kx < end;) {
-        const long lx = lx0 + kx;
-        const long in_tile = lx & (kTileSize - 1);
-        const long run = std::min(end - kx, kTileSize - in_tile);
-        std::uint8_t* target =
-            &tile_cells_[static_cast<std::size_t>(index_row[lx >> kTileShift]) * kTileCells + cell_row +
-                         in_tile];
-        const std::uint8_t* value = kernel_row + kx;
-        for (long i = 0; i < run; ++i) target[i] = std::max(target[i], value[i]);
-        kx += run;
+    const std::size_t offset = cellOffset(cx, cy);
+    std::uint64_t& word = stamped_[offset / 64];
+    const std::uint64_t bit = std::uint64_t{1} << (offset % 64);
+    if (word & bit) continue;
+    word |= bit;
+    stamp(cx, cy);
+  }
+}
+
+void LookupTable::stamp(long cx, long cy) {
+  const long r = kernel_radius_;
+  if (2 * r + 1 > kTileSize) {
+    stampWide(cx, cy);
+    return;
+  }
+  const long x0 = cx - r, y0 = cy - r;  // the stamp's first column and row
+  // A tile is wider than a stamp: its columns cross at most one tile edge, at kernel column `split`, and
+  // its rows at most one, at kernel row `split_row`.
+  const long tile_x = x0 >> kTileShift, in_tile_x = x0 & (kTileSize - 1);
+  const long split = kTileSize - in_tile_x;
+  const long split_row = kTileSize - (y0 & (kTileSize - 1));
+  const std::int32_t* upper = &tile_offset_[tileSlot(0, y0, stride_shift_)];
+  const std::int32_t* lower = &tile_offset_[tileSlot(0, y0 + kTileSize, stride_shift_)];
+  // Each side's cell of the stamp's first row (kernel row 0) in the upper tiles and, shifted back by
+  // split_row rows, in the lower ones: the cell of kernel row ky is then base + ky * kTileSize.
+  std::uint8_t* cells = tile_cells_.data();
+  const long first_row = (y0 & (kTileSize - 1)) << kTileShift;
+  std::uint8_t* upper_left = cells + upper[tile_x] + first_row + in_tile_x;
+  std::uint8_t* upper_right = cells + upper[tile_x + 1] + first_row - split;
+  std::uint8_t* lower_left = cells + lower[tile_x] - split_row * kTileSize + in_tile_x;
+  std::uint8_t* lower_right = cells + lower[tile_x + 1] - split_row * kTileSize - split;
+  // Only the kernel's non-zero rows (a round kernel leaves the square's outer rows empty).
+  const long rows_up = std::clamp(split_row, kernel_rows_.first, kernel_rows_.second);
+  stampRows(kernel_rows_.first, rows_up, split, upper_left, upper_right);
+  stampRows(rows_up, kernel_rows_.second, split, lower_left, lower_right);
+}
+
+void LookupTable::stampWide(long cx, long cy) {
+  // A kernel wider than a tile (not the presets'): each row in runs that stay within one tile.
+  const long r = kernel_radius_;
+  for (long ky = kernel_rows_.first; ky < kernel_rows_.second; ++ky) {
+    const long ly = cy - r + ky;
+    const std::int32_t* offsets = &tile_offset_[tileSlot(0, ly, stride_shift_)];
+    const long row = (ly & (kTileSize - 1)) << kTileShift;
+    const long end = kernel_spans_[ky].second;
+    for (long kx = kernel_spans_[ky].first; kx < end;) {
+      const long lx = cx - r + kx;
+      const long in_tile = lx & (kTileSize - 1);
+      const long run = std::min(end - kx, kTileSize - in_tile);
+      maxInto(&tile_cells_[offsets[lx >> kTileShift] + row + in_tile], &kernel_[ky * kernel_stride_ + kx],
+              run);
+      kx += run;
+    }
+  }
+}
+
+void LookupTable::stampRows(long begin, long end, long split, std::uint8_t* left, std::uint8_t* right) {
+  // Locals, not members: the byte stores below may alias anything, so members would be reloaded per row.
+  const std::uint8_t* kernel = kernel_.data();
+  const long kernel_stride = kernel_stride_;
+  const std::pair<long, long>* spans = kernel_spans_.data();
+  const bool narrow = 2 * kernel_radius_ + 1 <= kChunk;  // a row in one chunk (the defaults: 15 of 17)
+  const std::uint8_t* all = kLeadingBytes.mask[kChunk];
+  for (long ky = begin; ky < end; ++ky) {
+    std::uint8_t* row_left = left + ky * kTileSize;
+    std::uint8_t* row_right = right + ky * kTileSize;
+    const std::uint8_t* kernel_row = kernel + ky * kernel_stride;
+    const long first = spans[ky].first, last = spans[ky].second;
+    if (narrow) {
+      // One chunk on each side of the edge: masked before it; past the span the kernel row is zero.
+      if (last <= split) {
+        maxChunk(row_left + first, kernel_row + first, all);
+      } else if (first >= split) {
+        maxChunk(row_right + first, kernel_row + first, all);
+      } else {
+        maxChunk(row_left + first, kernel_row + first, kLeadingBytes.mask[split - first]);
+        maxChunk(row_right + split, kernel_row + split, all);
       }
+    } else {
+      maxInto(row_left + first, kernel_row + first, std::min(last, split) - first);
+      const long right_first = std::max(first, split);
+      maxInto(row_right + right_first, kernel_row + right_first, last - right_first);
     }
   }
 }
@@ -241,11 +368,7 @@ std::uint8_t LookupTable::valueAt(const Eigen::Vector2d& query_point) const {
   const double fx = point.x() * inv_cell_size_ - origin_cell_x_;
   const double fy = point.y() * inv_cell_size_ - origin_cell_y_;
   if (!(fx >= 0.0 && fy >= 0.0 && fx < tiles_x_ * kTileSize && fy < tiles_y_ * kTileSize)) return 0;
-  const long lx = static_cast<long>(fx), ly = static_cast<long>(fy);
-  const std::int32_t index = tile_index_[(ly >> kTileShift) * tiles_x_ + (lx >> kTileShift)];
-  if (index < 0) return 0;
-  return tile_cells_[static_cast<std::size_t>(index) * kTileCells + ((ly & (kTileSize - 1)) << kTileShift) +
-                     (lx & (kTileSize - 1))];
+  return tile_cells_[cellOffset(static_cast<long>(fx), static_cast<long>(fy))];
 }
 
 int LookupTable::beamsThroughSurfaces(const std::vector<Eigen::Vector2d>& points, const Pose2D& sensor,

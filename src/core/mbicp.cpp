@@ -110,6 +110,19 @@ void Mbicp::setReference(const ReferencePoints& reference) {
             [&](int a, int b) { return bearing[a] < bearing[b]; });
   sorted_bearing_.resize(n);
   for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
+  // Where each of n equal bearing buckets starts in sorted_bearing_.
+  bucket_first_.resize(n + 1);
+  for (std::size_t b = 0; b <= n; ++b) {
+    const double edge =
+        -M_PI + 2.0 * M_PI * static_cast<double>(b) / static_cast<double>(std::max<std::size_t>(n, 1));
+    bucket_first_[b] = static_cast<int>(
+        std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), edge) - sorted_bearing_.begin());
+  }
+  const double l_sq = options_.metric_l * options_.metric_l;
+  ref_metric_scale_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) ref_metric_scale_[i] = ref_points_[i].squaredNorm() + l_sq;
+  segment_seen_.assign(n, 0u);
+  walk_id_ = 0;
 }
 
 void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
@@ -130,25 +143,25 @@ void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
   }
 }
 
-void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const {
-  const double d_sq = dapSquared(p, ref_points_[j], l_sq);
+inline void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double, Candidate* candidate) const {
+  // dapSquared() with the point's |q|^2 + L^2 precomputed.
+  const Eigen::Vector2d& q = ref_points_[j];
+  const Eigen::Vector2d d = p - q;
+  const double cross = d.x() * q.y() - d.y() * q.x();
+  const double d_sq = d.squaredNorm() - cross * cross / ref_metric_scale_[j];
   if (d_sq < candidate->best) {
-    candidate->best = d_sq, candidate->found = true;
-    Association& association = candidate->association;
-    association.target = ref_points_[j];
-    association.normal = ref_normals_[j];
-    association.on_segment = false;
-    const bool isolated = ref_normals_[j].isZero();
-    association.sampling_tangent = isolated ? ref_tangents_[j] : Eigen::Vector2d::Zero();
-    association.sampling_variance = isolated ? ref_sampling_variance_[j] : 0.0;
+    candidate->best = d_sq;
+    candidate->element = j;
+    candidate->segment = false;
+    candidate->target = q;
   }
 }
 
-void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const {
+inline void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double u_scale,
+                                   Candidate* candidate) const {
   // Closest point of segment j -> j+1 under the metric, with the metric frozen at p (it varies slowly):
   // minimise (a - t e)^T M (a - t e), M = I - u u^T / (|p|^2 + L^2), u = (p_y, -p_x).
   const Eigen::Vector2d u(p.y(), -p.x());
-  const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
   const Eigen::Vector2d& q = ref_points_[j];
   const Eigen::Vector2d e = ref_points_[j + 1] - q;
   const Eigen::Vector2d a = p - q;
@@ -160,80 +173,110 @@ void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, Candid
   const Eigen::Vector2d on_segment = q + t * e;
   const double d_sq = dapSquared(p, on_segment, l_sq);
   if (d_sq < candidate->best) {
-    candidate->best = d_sq, candidate->found = true;
-    Association& association = candidate->association;
-    association.target = on_segment;
-    association.normal = unitNormal(e);
-    association.on_segment = true;
-    association.sampling_tangent = Eigen::Vector2d::Zero();
-    association.sampling_variance = 0.0;
+    candidate->best = d_sq;
+    candidate->element = j;
+    candidate->segment = true;
+    candidate->target = on_segment;
   }
 }
 
-void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate,
-                      std::vector<Association>* out) const {
-  out->clear();
-  const double l_sq = options_.metric_l * options_.metric_l;
-  const double gate_sq = gate * gate;
-  const double window = std::min(options_.bearing_window, M_PI);
+Mbicp::Association Mbicp::associationOf(const Eigen::Vector2d& p, const Candidate& candidate) const {
+  const int j = candidate.element;
+  Association association;
+  association.point = p;
+  association.target = candidate.target;
+  association.on_segment = candidate.segment;
+  association.distance_sq = std::max(0.0, candidate.best);
+  association.weight = 1.0;
+  const bool isolated = !candidate.segment && ref_normals_[j].isZero();
+  association.normal = candidate.segment ? unitNormal(ref_points_[j + 1] - ref_points_[j]) : ref_normals_[j];
+  association.sampling_tangent = isolated ? ref_tangents_[j] : Eigen::Vector2d::Zero();
+  association.sampling_variance = isolated ? ref_sampling_variance_[j] : 0.0;
+  return association;
+}
 
+int Mbicp::walkStart(double bearing) const {
+  // std::lower_bound() of the bearing, from its bucket's first point (a step or two, not a search).
+  const int n = static_cast<int>(sorted_bearing_.size());
+  const int buckets = static_cast<int>(bucket_first_.size()) - 1;
+  if (!(buckets > 0) || !(bearing == bearing)) {
+    return static_cast<int>(std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), bearing) -
+                            sorted_bearing_.begin());
+  }
+  const double position = (bearing + M_PI) * (buckets / (2.0 * M_PI));
+  int k = bucket_first_[std::clamp(static_cast<int>(position), 0, buckets - 1)];
+  while (k > 0 && sorted_bearing_[k - 1] >= bearing) --k;
+  while (k < n && sorted_bearing_[k] < bearing) ++k;
+  return k;
+}
+
+void Mbicp::associatePoint(const Eigen::Vector2d& p, double gate_sq, Candidate* candidate) {
+  const double l_sq = options_.metric_l * options_.metric_l;
+  const double window = std::min(options_.bearing_window, M_PI);
+  const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
+  double& best = candidate->best;
+  best = gate_sq;
+  if (++walk_id_ == 0) {
+    std::fill(segment_seen_.begin(), segment_seen_.end(), 0u);
+    walk_id_ = 1;
+  }
+  // Walk outward in bearing from p's own bearing, both ways, within the window (wrapping at +-pi for
+  // 360-degree scans). A reference point at bearing offset D is at least |p| sin D away from p, and
+  // d_ap^2 >= |d|^2 L^2 / ((|p| + |d|)^2 + L^2), which grows with |d|: once that bound exceeds the
+  // best candidate so far, nothing farther in bearing can win, and the walk stops.
+  const double bearing = std::atan2(p.y(), p.x());
+  const double range = p.norm();
+  const int n = static_cast<int>(sorted_bearing_.size());
+  const int start = walkStart(bearing);
+  double reach = window;
+  double reach_best = -1.0;
+  auto update_reach = [&]() {
+    // Smallest |d| whose bound reaches `best`: root of d^2 (L^2 - best) - 2 best |p| d - best (|p|^2 + L^2).
+    reach_best = best;
+    const double denominator = l_sq - best;
+    if (!(denominator > 0.0) || !(range > 0.0)) {
+      reach = window;
+      return;
+    }
+    const double d_min = (best * range + std::sqrt(best * best * range * range +
+                                                   denominator * best * (range * range + l_sq))) /
+                         denominator;
+    reach = d_min >= range ? window : std::min(window, std::asin(d_min / range));
+  };
+  // A segment is considered from either end point, once (a second time could not change the best).
+  const auto segment = [&](int j) {
+    if (!ref_has_next_[j] || segment_seen_[j] == walk_id_) return;
+    segment_seen_[j] = walk_id_;
+    considerSegment(p, j, l_sq, u_scale, candidate);
+  };
+  auto visit = [&](int j) {
+    considerPoint(p, j, l_sq, candidate);
+    segment(j);
+    if (j > 0) segment(j - 1);
+    // The reach from a larger `best` is still a valid (looser) bound: refresh only on a real gain.
+    if (best < 0.5 * reach_best) update_reach();
+  };
+  update_reach();
+  for (int step = 0; step < n; ++step) {  // counter-clockwise
+    int k = start + step;
+    double offset = (k >= n ? sorted_bearing_[k -= n] + 2.0 * M_PI : sorted_bearing_[k]) - bearing;
+    if (offset > reach) break;
+    visit(sorted_index_[k]);
+  }
+  for (int step = 1; step < n; ++step) {  // clockwise
+    int k = start - step;
+    double offset = bearing - (k < 0 ? sorted_bearing_[k += n] - 2.0 * M_PI : sorted_bearing_[k]);
+    if (offset > reach) break;
+    visit(sorted_index_[k]);
+  }
+}
+
+void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) {
+  out->clear();
   for (const auto& p : moved) {
     Candidate candidate;
-    candidate.best = gate_sq;
-    double& best = candidate.best;
-
-    // Walk outward in bearing from p's own bearing, both ways, within the window (wrapping at +-pi for
-    // 360-degree scans). A reference point at bearing offset D is at least |p| sin D away from p, and
-    // d_ap^2 >= |d|^2 L^2 / ((|p| + |d|)^2 + L^2), which grows with |d|: once that bound exceeds the
-    // best candidate so far, nothing farther in bearing can win, and the walk stops.
-    const double bearing = std::atan2(p.y(), p.x());
-    const double range = p.norm();
-    const int n = static_cast<int>(sorted_bearing_.size());
-    const int start = static_cast<int>(
-        std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), bearing) - sorted_bearing_.begin());
-    double reach = window;
-    double reach_best = -1.0;
-    auto update_reach = [&]() {
-      // Smallest |d| whose bound reaches `best`: root of d^2 (L^2 - best) - 2 best |p| d - best (|p|^2 +
-      // L^2).
-      reach_best = best;
-      const double denominator = l_sq - best;
-      if (!(denominator > 0.0) || !(range > 0.0)) {
-        reach = window;
-        return;
-      }
-      const double d_min = (best * range + std::sqrt(best * best * range * range +
-                                                     denominator * best * (range * range + l_sq))) /
-                           denominator;
-      reach = d_min >= range ? window : std::min(window, std::asin(d_min / range));
-    };
-    auto visit = [&](int j) {
-      considerPoint(p, j, l_sq, &candidate);
-      if (ref_has_next_[j]) considerSegment(p, j, l_sq, &candidate);
-      if (j > 0 && ref_has_next_[j - 1]) considerSegment(p, j - 1, l_sq, &candidate);
-      // The reach from a larger `best` is still a valid (looser) bound: refresh only on a real gain.
-      if (best < 0.5 * reach_best) update_reach();
-    };
-    update_reach();
-    for (int step = 0; step < n; ++step) {  // counter-clockwise
-      int k = start + step;
-      double offset = (k >= n ? sorted_bearing_[k -= n] + 2.0 * M_PI : sorted_bearing_[k]) - bearing;
-      if (offset > reach) break;
-      visit(sorted_index_[k]);
-    }
-    for (int step = 1; step < n; ++step) {  // clockwise
-      int k = start - step;
-      double offset = bearing - (k < 0 ? sorted_bearing_[k += n] - 2.0 * M_PI : sorted_bearing_[k]);
-      if (offset > reach) break;
-      visit(sorted_index_[k]);
-    }
-
-    if (candidate.found) {
-      candidate.association.point = p;
-      candidate.association.distance_sq = std::max(0.0, best);
-      candidate.association.weight = 1.0;
-      out->push_back(candidate.association);
-    }
+    associatePoint(p, gate * gate, &candidate);
+    if (candidate.element >= 0) out->push_back(associationOf(p, candidate));
   }
 }
 

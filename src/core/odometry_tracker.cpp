@@ -465,11 +465,14 @@ void OdometryTracker::learnCalibration(const MotionPrediction& prediction, const
   // larger translation variance of each: the direction of travel is unknown here).
   const Eigen::Matrix3d scans = scan_covariance + scan_only_covariance_;
   const double heading_variance = prediction.covariance(2, 2) + scans(2, 2);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> translation(
-      prediction.covariance.topLeftCorner<2, 2>() + scans.topLeftCorner<2, 2>());
+  // The larger eigenvalue of the 2 x 2 translation block, in closed form.
+  const Eigen::Matrix2d translation =
+      prediction.covariance.topLeftCorner<2, 2>() + scans.topLeftCorner<2, 2>();
+  const double half_trace = 0.5 * (translation(0, 0) + translation(1, 1));
+  const double larger =
+      half_trace + std::hypot(0.5 * (translation(0, 0) - translation(1, 1)), translation(0, 1));
   // An IMU gave the rotation: the wheels' turn says nothing about their heading errors.
-  calibration_.learn(prediction.wheel_motion, scan_motion, prediction.gyro ? -1.0 : heading_variance,
-                     translation.eigenvalues().maxCoeff());
+  calibration_.learn(prediction.wheel_motion, scan_motion, prediction.gyro ? -1.0 : heading_variance, larger);
   extrapolator_.setWheelCalibration(calibration_);
 }
 

@@ -75,14 +75,6 @@ double scanSweepTime(double time_increment, std::size_t beam_count, const ScanCo
   return 0.0;
 }
 
-void ReferencePoints::append(const std::vector<Eigen::Vector2d>& scan_points, const Pose2D& pose) {
-  if (scan_points.empty()) return;
-  scan_starts.push_back(points.size());
-  scan_origins.emplace_back(pose.x, pose.y);
-  points.reserve(points.size() + scan_points.size());
-  for (const auto& point : scan_points) points.push_back(pose * point);
-}
-
 std::vector<std::uint8_t> ReferencePoints::sameScanAsNext() const {
   std::vector<std::uint8_t> same(points.size(), 1);
   if (!points.empty()) same.back() = 0;
@@ -110,12 +102,46 @@ double medianAngularStep(const std::vector<Eigen::Vector2d>& points, std::size_t
   return steps[steps.size() / 2];
 }
 
+/// Records the points of `reference` from `start` on as a scan seen from `origin`.
+void addScan(ReferencePoints* reference, std::size_t start, const Eigen::Vector2d& origin) {
+  reference->scan_starts.push_back(start);
+  reference->scan_origins.push_back(origin);
+  // Cached while every scan came through here (angularStep() computes what is not cached).
+  std::vector<double>& steps = reference->scan_steps;
+  if (steps.size() + 1 == reference->scan_starts.size()) {
+    steps.push_back(medianAngularStep(reference->points, start, reference->points.size(), origin));
+  } else {
+    steps.clear();
+  }
+}
+
 }  // namespace
 
 double angularStep(const ReferencePoints& reference, std::size_t scan) {
+  if (scan < reference.scan_steps.size()) return reference.scan_steps[scan];
   if (scan >= reference.scan_starts.size()) return 0.0;
   return medianAngularStep(reference.points, reference.scan_starts[scan], reference.scanEnd(scan),
                            reference.scanOrigin(scan));
+}
+
+void ReferencePoints::append(const std::vector<Eigen::Vector2d>& scan_points, const Pose2D& pose) {
+  if (scan_points.empty()) return;
+  const std::size_t start = points.size();
+  // pose * point, with the rotation's cosine and sine computed once.
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  points.reserve(start + scan_points.size());
+  for (const auto& point : scan_points) {
+    points.emplace_back(pose.x + c * point.x() - s * point.y(), pose.y + s * point.x() + c * point.y());
+  }
+  addScan(this, start, Eigen::Vector2d(pose.x, pose.y));
+}
+
+void ReferencePoints::appendMoved(const std::vector<Eigen::Vector2d>& moved_points,
+                                  const Eigen::Vector2d& origin) {
+  if (moved_points.empty()) return;
+  const std::size_t start = points.size();
+  points.insert(points.end(), moved_points.begin(), moved_points.end());
+  addScan(this, start, origin);
 }
 
 std::vector<std::uint8_t> joinSurfaces(const ReferencePoints& reference, const SurfaceOptions& options) {
@@ -152,6 +178,17 @@ Scan selectBeams(const Scan& scan, int parity) {
   }
   out.invalid_count = 0;
   return out;
+}
+
+void transformPoints(const std::vector<Eigen::Vector2d>& points, const Pose2D& pose,
+                     std::vector<Eigen::Vector2d>* moved) {
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  moved->resize(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d& point = points[i];
+    (*moved)[i] =
+        Eigen::Vector2d(pose.x + c * point.x() - s * point.y(), pose.y + s * point.x() + c * point.y());
+  }
 }
 
 Scan transformScan(const Scan& scan, const Pose2D& pose) {

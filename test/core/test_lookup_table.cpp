@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "test_util.h"
 
@@ -438,3 +439,47 @@ TEST(LookupTable, BeamsThroughSurfacesIsZeroForAnEmptyTableOrPose) {
   EXPECT_EQ(table.beamsThroughSurfaces({{3.0, 0.0}}, hglasm::Pose2D(nan, 0.0, 0.0), 0.3), 0);
   EXPECT_EQ(table.beamsThroughSurfaces({{nan, 0.0}}, hglasm::Pose2D(), 0.3), 0);
 }
+
+namespace {
+
+/// Every cell around random points holds the kernel's value at its nearest centre cell (the maximum of
+/// the stamps), computed here independently, for kernels narrower than a 16-byte chunk, up to a tile and
+/// wider than a tile, wherever the stamps fall against the tiles' edges.
+void expectStampsOfRandomPoints(double cell, double cutoff) {
+  LookupTableOptions options = gradedOptions();
+  options.cell_size = cell;
+  options.cutoff = cutoff;
+  LookupTable table(options);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.5);
+  Points points;
+  for (int i = 0; i < 40; ++i) points.emplace_back(coordinate(rng), coordinate(rng));
+  table.build(points);
+  std::vector<std::pair<long, long>> centres;
+  for (const auto& p : points) {
+    centres.emplace_back(static_cast<long>(std::floor(p.x() / cell)),
+                         static_cast<long>(std::floor(p.y() / cell)));
+  }
+  const long reach = static_cast<long>(std::ceil(cutoff / cell)) + 2;
+  const long low = static_cast<long>(std::floor(-1.0 / cell)) - reach;
+  const long high = static_cast<long>(std::floor(1.5 / cell)) + reach;
+  for (long y = low; y <= high; y += 3) {
+    for (long x = low; x <= high; ++x) {
+      long expected = 0;
+      for (const auto& centre : centres) {
+        const double distance = std::hypot(x - centre.first, y - centre.second) * cell;
+        if (distance <= cutoff) expected = std::max(expected, std::lround(normal255(distance)));
+      }
+      const Eigen::Vector2d at((x + 0.5) * cell, (y + 0.5) * cell);
+      ASSERT_EQ(table.valueAt(at), expected) << "cell " << x << " " << y << ", cell size " << cell;
+    }
+  }
+}
+
+TEST(LookupTable, StampsOfAnyWidthHoldTheNearestCentresValue) {
+  expectStampsOfRandomPoints(0.04, 0.30);   // 15 columns: one 16-byte chunk per row
+  expectStampsOfRandomPoints(0.02, 0.30);   // 31 columns: chunks, within a tile
+  expectStampsOfRandomPoints(0.008, 0.30);  // 77 columns: wider than a tile
+}
+
+}  // namespace

@@ -108,20 +108,45 @@ class LookupTable {
     return std::abs(p.x()) <= kMaxCoordinate && std::abs(p.y()) <= kMaxCoordinate;  // false for NaN
   }
   void buildKernel();
-  /// Widens the tile grid (keeping the tiles it has) to cover global cells [min, max] on both axes.
-  void growGrid(long min_cx, long max_cx, long min_cy, long max_cy);
-  /// Stamps the kernel around every centre of cells_ not stamped before.
-  void stampCells();
+  struct Box {
+    long min_x = 0, max_x = -1, min_y = 0, max_y = -1;
+  };
+  /// The stamp centres' global cells (cells_) and their bounding box; false if there is none.
+  bool collectCells(const ReferencePoints& reference, Box* box);
+  /// Widens the tile grid (keeping the tiles it has) to the box grown by the kernel radius, and gives the
+  /// cells_' stamps their tiles.
+  void allocateTiles(const Box& box);
+  /// The grid's first and last tile on each axis for a box of cells.
+  Box tileRange(const Box& box) const;
+  void regrid(const Box& tiles);
+  /// A tile of cells for tile_offset_'s entry `slot` if it has none.
+  void allocateTile(long slot);
+  /// Maxes the kernel into the cells around table cell (cx, cy).
+  void stamp(long cx, long cy);
+  void stampWide(long cx, long cy);  // the same for a kernel wider than a tile
+  /// Kernel rows [begin, end) of a stamp: kernel column c goes to left[ky * kTileSize + c] before column
+  /// `split` (a tile edge), to right[ky * kTileSize + c] from it on.
+  void stampRows(long begin, long end, long split, std::uint8_t* left, std::uint8_t* right);
+  /// tile_offset_'s entry of the tile holding table cell (x, y), x and y >= -kTileSize (the ring).
+  static long tileSlot(long x, long y, int stride_shift) {
+    return (((y >> kTileShift) + 1) << stride_shift) + (x >> kTileShift) + 1;
+  }
+  /// Index into tile_cells_ (or stamped_'s bits) of the cell at table coordinates (x, y), x and y >=
+  /// -kTileSize.
+  std::size_t cellOffset(long x, long y) const {
+    return static_cast<std::size_t>(tile_offset_[tileSlot(x, y, stride_shift_)]) +
+           static_cast<std::size_t>(((y & (kTileSize - 1)) << kTileShift) + (x & (kTileSize - 1)));
+  }
   /// Stamp centres (samples_): the points, samples along joined gaps and isolated points' footprints.
   void collectSamples(const ReferencePoints& reference);
   /// Adds samples across the beam of each isolated reference point (isolated_footprint).
   void stampFootprints(const ReferencePoints& reference, const std::vector<std::uint8_t>& joins,
                        double spacing);
 
-  /// Calls f(cell value) for every point of `points` moved by `pose` that lands on an allocated tile.
-  /// One transform and one byte read per point: the cell scaling is folded into the transform, which runs
-  /// in blocks the compiler vectorises; coordinates are clamped to [-1, size] first (NaN -> -1), so the
-  /// integer conversion is always defined and one unsigned comparison per axis is the bounds check.
+  /// Calls f(cell value) for every point of `points` moved by `pose` (0 off the table). One transform and
+  /// one byte read per point, no branch: the cell scaling is folded into the transform, which runs in
+  /// blocks the compiler vectorises; coordinates are clamped into the ring of zero tiles around the table
+  /// (NaN -> onto the ring), whose tiles, like every tile without cells, share one tile of zeros.
   template <typename F>
   void forEachCell(const FitnessPoints& points, const Pose2D& query_pose, F&& f) const {
     if (tiles_in_use_ == 0 || !query_pose.isFinite()) return;
@@ -130,14 +155,14 @@ class LookupTable {
     const float s = static_cast<float>(std::sin(pose.theta) * inv_cell_size_);
     const float ox = static_cast<float>(pose.x * inv_cell_size_ - origin_cell_x_);
     const float oy = static_cast<float>(pose.y * inv_cell_size_ - origin_cell_y_);
-    const std::uint32_t width = static_cast<std::uint32_t>(tiles_x_ * kTileSize);
-    const std::uint32_t height = static_cast<std::uint32_t>(tiles_y_ * kTileSize);
-    const float max_x = static_cast<float>(width), max_y = static_cast<float>(height);
-    const std::int32_t* index = tile_index_.data();
+    constexpr float kRing = static_cast<float>(kTileSize);
+    const float max_x = static_cast<float>(tiles_x_ * kTileSize) + kRing - 1.0f;
+    const float max_y = static_cast<float>(tiles_y_ * kTileSize) + kRing - 1.0f;
+    const std::int32_t* offsets = tile_offset_.data();
     const std::uint8_t* cells = tile_cells_.data();
-    const long tiles_x = tiles_x_;
+    const int stride_shift = stride_shift_;
     constexpr std::size_t kBlock = 64;
-    std::int32_t cell_x[kBlock], cell_y[kBlock];
+    std::int32_t tile[kBlock], in_tile[kBlock];
     const std::size_t n = points.size();
     const float* px = points.x.data();
     const float* py = points.y.data();
@@ -146,18 +171,12 @@ class LookupTable {
       for (std::size_t i = 0; i < count; ++i) {
         const float fx = c * px[begin + i] - s * py[begin + i] + ox;
         const float fy = s * px[begin + i] + c * py[begin + i] + oy;
-        cell_x[i] = static_cast<std::int32_t>(std::min(std::max(-1.0f, fx), max_x));
-        cell_y[i] = static_cast<std::int32_t>(std::min(std::max(-1.0f, fy), max_y));
+        const auto lx = static_cast<std::int32_t>(std::min(std::max(-kRing, fx), max_x));
+        const auto ly = static_cast<std::int32_t>(std::min(std::max(-kRing, fy), max_y));
+        tile[i] = static_cast<std::int32_t>(tileSlot(lx, ly, stride_shift));
+        in_tile[i] = ((ly & (kTileSize - 1)) << kTileShift) + (lx & (kTileSize - 1));
       }
-      for (std::size_t i = 0; i < count; ++i) {
-        const std::uint32_t lx = static_cast<std::uint32_t>(cell_x[i]);
-        const std::uint32_t ly = static_cast<std::uint32_t>(cell_y[i]);
-        if (lx >= width || ly >= height) continue;
-        const std::int32_t tile = index[(ly >> kTileShift) * tiles_x + (lx >> kTileShift)];
-        if (tile < 0) continue;
-        f(cells[static_cast<std::size_t>(tile) * kTileCells + ((ly & (kTileSize - 1)) << kTileShift) +
-                (lx & (kTileSize - 1))]);
-      }
+      for (std::size_t i = 0; i < count; ++i) f(cells[offsets[tile[i]] + in_tile[i]]);
     }
   }
 
@@ -167,15 +186,23 @@ class LookupTable {
   long origin_cell_y_ = 0;
   long tiles_x_ = 0;
   long tiles_y_ = 0;
-  std::vector<std::int32_t> tile_index_;  // tiles_x_ * tiles_y_, -1 = no tile
-  std::vector<std::uint8_t> tile_cells_;  // tiles_in_use_ * kTileCells
-  std::size_t tiles_in_use_ = 0;
+  /// Rows of 2^stride_shift_ >= tiles_x_ + 2 tiles, tiles_y_ + 2 of them, the ring included: each tile's
+  /// first cell in tile_cells_ (the zero tile's where it has no cells).
+  std::vector<std::int32_t> tile_offset_;
+  int stride_shift_ = 0;
+  std::vector<std::uint8_t> tile_cells_;  // tile_slots_ * kTileCells (the zero tile among them), padding
+  std::size_t tiles_in_use_ = 0;          // tiles with cells
+  std::size_t tile_slots_ = 0;            // tiles in tile_cells_: those and the zero tile
+  std::int32_t zero_tile_ = 0;            // the zero tile's first cell in tile_cells_
   Pose2D query_in_table_;
-  std::vector<Eigen::Vector2d> samples_;             // scratch: stamp centres
-  std::vector<std::pair<long, long>> cells_;         // scratch: their global cells
-  std::vector<std::uint8_t> stamped_;                // scratch: 1 where a stamp is centred (as tile_cells_)
-  std::vector<std::uint8_t> kernel_;                 // (2r+1)^2 stamp, r = ceil(cutoff / cell_size)
+  std::vector<Eigen::Vector2d> samples_;      // scratch: stamp centres
+  std::vector<std::pair<long, long>> cells_;  // scratch: their global cells
+  std::vector<std::uint64_t>
+      stamped_;                       // scratch: a bit per cell of tile_cells_, set where a stamp is centred
+  std::vector<std::uint8_t> kernel_;  // (2r+1) rows of kernel_stride_ bytes, r = ceil(cutoff / cell_size)
+  long kernel_stride_ = 0;
   std::vector<std::pair<long, long>> kernel_spans_;  // per kernel row: [first, last) non-zero columns
+  std::pair<long, long> kernel_rows_;                // [first, last) rows with a non-zero column
   int kernel_radius_ = 0;
 };
 

@@ -140,12 +140,21 @@ class Mbicp {
   /// The best association of one point so far (d_ap^2 below `best`).
   struct Candidate {
     double best = 0.0;
-    bool found = false;
-    Association association;
+    int element = -1;  // reference point, or segment from it to the next; -1: none yet
+    bool segment = false;
+    Eigen::Vector2d target;  // the point on the element
   };
+  /// The association of p with its candidate's element.
+  Association associationOf(const Eigen::Vector2d& p, const Candidate& candidate) const;
   void considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const;
-  void considerSegment(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const;
-  void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) const;
+  /// u_scale: 1 / (|p|^2 + L^2), the metric frozen at p.
+  void considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double u_scale,
+                       Candidate* candidate) const;
+  /// The best association of one point (its bearing walk).
+  void associatePoint(const Eigen::Vector2d& p, double gate_sq, Candidate* candidate);
+  /// The first index of sorted_bearing_ not below `bearing` (std::lower_bound).
+  int walkStart(double bearing) const;
+  void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out);
   /// c^2 of the robust weights for the current associations (0: no weights).
   double robustScaleSq() const;
   /// The d_ap metric of one association (to its segment's line, or weighed against an isolated reference
@@ -169,7 +178,11 @@ class Mbicp {
   std::vector<double> ref_sampling_variance_;  // (range * angular spacing)^2 / 12 of each point
   std::vector<double> sorted_bearing_;         // bearings of reference points, ascending
   std::vector<int> sorted_index_;              // their indices into ref_points_
-  std::vector<Association> associations_;      // scratch
+  std::vector<int> bucket_first_;  // first sorted index of each of n equal bearing buckets (n + 1 entries)
+  std::vector<double> ref_metric_scale_;     // |q|^2 + L^2 of each point (d_ap's denominator)
+  std::vector<std::uint32_t> segment_seen_;  // per segment: the last point whose walk considered it
+  std::uint32_t walk_id_ = 0;
+  std::vector<Association> associations_;                       // scratch
   Eigen::Matrix3d scan_information_ = Eigen::Matrix3d::Zero();  // of the last step, increment coordinates
   ScanNoiseScale scan_noise_scale_ = ScanNoiseScale::Ones();
   std::vector<Eigen::Vector2d> moved_;  // scratch

@@ -62,9 +62,14 @@ struct ReferencePoints {
   std::vector<Eigen::Vector2d> points;
   std::vector<std::size_t> scan_starts;       ///< index of each scan's first point, ascending
   std::vector<Eigen::Vector2d> scan_origins;  ///< each scan's sensor position in this set's frame
+  /// Each scan's angular step (angularStep()), computed once when it is appended (empty if some scan was
+  /// not appended with append()).
+  std::vector<double> scan_steps;
 
   /// Appends a scan's points moved by `pose` (the scan's frame in this set's frame) as a new scan.
   void append(const std::vector<Eigen::Vector2d>& scan_points, const Pose2D& pose = Pose2D());
+  /// The same with the points already in this set's frame (transformPoints()), the sensor at `origin`.
+  void appendMoved(const std::vector<Eigen::Vector2d>& moved_points, const Eigen::Vector2d& origin);
 
   /// For each point: 1 if the next point belongs to the same scan.
   std::vector<std::uint8_t> sameScanAsNext() const;
@@ -82,6 +87,7 @@ struct ReferencePoints {
     points.clear();
     scan_starts.clear();
     scan_origins.clear();
+    scan_steps.clear();
   }
 };
 
@@ -118,6 +124,10 @@ Scan selectBeams(const Scan& scan, int parity);
 
 /// Applies `pose` to every point (beam indices kept).
 Scan transformScan(const Scan& scan, const Pose2D& pose);
+
+/// *moved = pose * each of `points` (the same numbers as Pose2D's operator, its cosine and sine once).
+void transformPoints(const std::vector<Eigen::Vector2d>& points, const Pose2D& pose,
+                     std::vector<Eigen::Vector2d>* moved);
 
 /// Seconds from a scan's first beam to its last (signed like time_increment): its own time_increment when
 /// that gives a sweep of at most kMaxSweepTime, else options.sweep_time, else 0 (not known).
