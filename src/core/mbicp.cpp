@@ -102,27 +102,45 @@ void Mbicp::setReference(const ReferencePoints& reference) {
       ref_normals_[i] = unitNormal(ref_points_[i] - ref_points_[i - 1]);
     }
   }
-  sorted_index_.resize(n);
-  std::iota(sorted_index_.begin(), sorted_index_.end(), 0);
-  std::vector<double> bearing(n);
-  for (std::size_t i = 0; i < n; ++i) bearing[i] = std::atan2(ref_points_[i].y(), ref_points_[i].x());
-  std::sort(sorted_index_.begin(), sorted_index_.end(),
-            [&](int a, int b) { return bearing[a] < bearing[b]; });
-  sorted_bearing_.resize(n);
-  for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
-  // Where each of n equal bearing buckets starts in sorted_bearing_.
-  bucket_first_.resize(n + 1);
-  for (std::size_t b = 0; b <= n; ++b) {
-    const double edge =
-        -M_PI + 2.0 * M_PI * static_cast<double>(b) / static_cast<double>(std::max<std::size_t>(n, 1));
-    bucket_first_[b] = static_cast<int>(
-        std::lower_bound(sorted_bearing_.begin(), sorted_bearing_.end(), edge) - sorted_bearing_.begin());
-  }
+  sortByBearing();
   const double l_sq = options_.metric_l * options_.metric_l;
   ref_metric_scale_.resize(n);
   for (std::size_t i = 0; i < n; ++i) ref_metric_scale_[i] = ref_points_[i].squaredNorm() + l_sq;
   segment_seen_.assign(n, 0u);
   walk_id_ = 0;
+}
+
+void Mbicp::sortByBearing() {
+  // A counting sort into n equal bearing buckets (the walk's starting points), then each small bucket by
+  // bearing: linear in the points where a comparison sort is not, for the local map's thousands.
+  const std::size_t n = ref_points_.size();
+  const std::size_t buckets = std::max<std::size_t>(n, 1);
+  const auto edge = [buckets](std::size_t b) {
+    return -M_PI + 2.0 * M_PI * static_cast<double>(b) / static_cast<double>(buckets);
+  };
+  std::vector<double> bearing(n);
+  std::vector<std::size_t> bucket(n);
+  bucket_first_.assign(buckets + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    bearing[i] = std::atan2(ref_points_[i].y(), ref_points_[i].x());
+    // The bucket whose edges hold the bearing, exactly as the edges are computed.
+    auto k = static_cast<std::size_t>(
+        std::clamp((bearing[i] + M_PI) / (2.0 * M_PI) * buckets, 0.0, static_cast<double>(buckets)));
+    while (k < buckets && edge(k + 1) <= bearing[i]) ++k;
+    while (k > 0 && edge(k) > bearing[i]) --k;
+    bucket[i] = k;
+    ++bucket_first_[k + 1];
+  }
+  for (std::size_t b = 0; b < buckets; ++b) bucket_first_[b + 1] += bucket_first_[b];
+  sorted_index_.resize(n);
+  std::vector<int> next(bucket_first_.begin(), bucket_first_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) sorted_index_[next[bucket[i]]++] = static_cast<int>(i);
+  for (std::size_t b = 0; b < buckets; ++b) {
+    std::sort(sorted_index_.begin() + bucket_first_[b], sorted_index_.begin() + bucket_first_[b + 1],
+              [&](int x, int y) { return bearing[x] < bearing[y] || (bearing[x] == bearing[y] && x < y); });
+  }
+  sorted_bearing_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
 }
 
 void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,

@@ -126,6 +126,8 @@ class Mbicp {
     double weight;  // robust weight of the last step (1 without robust_scale)
   };
   /// Per kept reference point: the direction across its beam and the variance of its sampling along it.
+  /// sorted_index_, sorted_bearing_ and bucket_first_ of the reference points.
+  void sortByBearing();
   void computeSamplingUncertainty(const ReferencePoints& reference,
                                   const std::vector<std::size_t>& scan_of_point);
   /// Convergence bookkeeping of the settled iterations.
