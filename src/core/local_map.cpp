@@ -63,7 +63,7 @@ void LocalMap::insert(Submap* submap, const Pose2D& laser_pose, const std::vecto
   submap->points.append(kept_, pose);
   if (options_.resolution > 0.0) {
     for (const Eigen::Vector2d& point : added_.points) {
-      if (point.allFinite()) submap->cells[cellKey(point, 0, 0)].push_back(point);
+      if (onGrid(point)) submap->cells[cellKey(point, 0, 0)].push_back(point);
     }
   }
   for (LookupTable& table : submap->tables) table.insert(added_);
@@ -95,7 +95,7 @@ std::uint64_t LocalMap::cellKey(const Eigen::Vector2d& point, int dx, int dy) co
 }
 
 bool LocalMap::covered(const Submap& submap, const Eigen::Vector2d& point) const {
-  if (!point.allFinite() || std::abs(point.x()) > 1e6 || std::abs(point.y()) > 1e6) return true;
+  if (!onGrid(point)) return true;
   const double limit_sq = options_.resolution * options_.resolution;
   for (int dx = -1; dx <= 1; ++dx) {
     for (int dy = -1; dy <= 1; ++dy) {

@@ -363,8 +363,11 @@ void LookupTable::stampRows(long begin, long end, long split, std::uint8_t* left
 }
 
 std::uint8_t LookupTable::valueAt(const Eigen::Vector2d& query_point) const {
+  return valueInTable(query_in_table_ * query_point);
+}
+
+std::uint8_t LookupTable::valueInTable(const Eigen::Vector2d& point) const {
   if (tiles_in_use_ == 0) return 0;
-  const Eigen::Vector2d point = query_in_table_ * query_point;
   const double fx = point.x() * inv_cell_size_ - origin_cell_x_;
   const double fy = point.y() * inv_cell_size_ - origin_cell_y_;
   if (!(fx >= 0.0 && fy >= 0.0 && fx < tiles_x_ * kTileSize && fy < tiles_y_ * kTileSize)) return 0;
@@ -377,14 +380,32 @@ int LookupTable::beamsThroughSurfaces(const std::vector<Eigen::Vector2d>& points
   // Steps of one cell: a graded surface's band (value >= max / 2) is 2.4 sigma wide, a binary one a cell.
   const double step = 1.0 / inv_cell_size_;
   const auto surface = static_cast<std::uint8_t>(std::max<std::uint32_t>(1, maxCellValue() / 2));
-  const Eigen::Vector2d origin = sensor.translation();
+  // In the table's own frame; a beam is walked only where it crosses the table's extent (a wild reading
+  // kilometres out would otherwise take millions of steps through nothing).
+  const Pose2D in_table = query_in_table_ * sensor;
+  const Eigen::Vector2d origin = in_table.translation();
+  const Eigen::Vector2d low(origin_cell_x_ * step, origin_cell_y_ * step);
+  const Eigen::Vector2d high = low + Eigen::Vector2d(tiles_x_, tiles_y_) * (kTileSize * step);
   int through = 0;
   for (const Eigen::Vector2d& point : points) {
     const double range = point.norm();
     if (!std::isfinite(range) || range <= 2.0 * margin) continue;
-    const Eigen::Vector2d direction = (sensor * point - origin) / range;
-    for (double r = margin; r < range - margin; r += step) {
-      if (valueAt(origin + r * direction) >= surface) {
+    const Eigen::Vector2d direction = (in_table * point - origin) / range;
+    double enter = margin, leave = range - margin;
+    for (int axis = 0; axis < 2 && enter < leave; ++axis) {
+      if (direction[axis] == 0.0) {
+        if (origin[axis] < low[axis] || origin[axis] > high[axis]) leave = enter;
+        continue;
+      }
+      const double a = (low[axis] - origin[axis]) / direction[axis];
+      const double b = (high[axis] - origin[axis]) / direction[axis];
+      enter = std::max(enter, std::min(a, b));
+      leave = std::min(leave, std::max(a, b));
+    }
+    // The same samples as a walk from the margin (every step from it), skipping those before the table.
+    const double first = margin + std::max(0.0, std::ceil((enter - margin) / step)) * step;
+    for (double r = first; r < leave; r += step) {
+      if (valueInTable(origin + r * direction) >= surface) {
         ++through;
         break;
       }

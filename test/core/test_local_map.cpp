@@ -176,6 +176,19 @@ TEST(LocalMap, RevisionChangesWithEveryAddAndClearOnly) {
   EXPECT_NE(map.revision(), second);
 }
 
+TEST(LocalMap, WildButFiniteReadingsNeverReachTheGrid) {
+  // A reading 1e30 m out (the fuzzer's) is finite but no grid cell: it is neither de-duplicated against nor
+  // remembered (the cell index would overflow), and the map stays usable.
+  LocalMapOptions options;
+  LocalMap map(options, {hglasm::LookupTableOptions()});
+  std::vector<Eigen::Vector2d> points = wall(2.0, 1.0, 0.05);
+  points.emplace_back(2.1e30, -1.6e26);
+  map.add(Pose2D(), points);
+  map.add(Pose2D(0.1, 0.0, 0.0), points);
+  EXPECT_EQ(map.keyframeCount(), 2u);
+  EXPECT_FALSE(map.table(0).empty());
+}
+
 TEST(LocalMap, AtLeastOneKeyframe) {
   LocalMapOptions options;
   options.keyframes = 0;

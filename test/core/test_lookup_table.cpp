@@ -438,6 +438,10 @@ TEST(LookupTable, BeamsThroughSurfacesIsZeroForAnEmptyTableOrPose) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(table.beamsThroughSurfaces({{3.0, 0.0}}, hglasm::Pose2D(nan, 0.0, 0.0), 0.3), 0);
   EXPECT_EQ(table.beamsThroughSurfaces({{nan, 0.0}}, hglasm::Pose2D(), 0.3), 0);
+  // A wild but finite reading (the fuzzer's 1e30 m) is walked only across the table: a count, at once.
+  EXPECT_EQ(table.beamsThroughSurfaces({{1e30, 0.0}, {1e12, 1e12}}, hglasm::Pose2D(), 0.3), 1);
+  // A beam that never meets the table's extent is not walked at all.
+  EXPECT_EQ(table.beamsThroughSurfaces({{0.0, 1e9}}, hglasm::Pose2D(0.0, 50.0, 0.0), 0.3), 0);
 }
 
 namespace {

@@ -73,6 +73,10 @@ class LocalMap {
   /// True if a point of the submap lies within options_.resolution of `point`.
   bool covered(const Submap& submap, const Eigen::Vector2d& point) const;
   std::uint64_t cellKey(const Eigen::Vector2d& point, int dx, int dy) const;
+  /// Points the de-duplication grid can hold (finite, within 1e6 m; wilder readings are never joined).
+  static bool onGrid(const Eigen::Vector2d& point) {
+    return std::abs(point.x()) <= 1e6 && std::abs(point.y()) <= 1e6;  // false for NaN
+  }
   /// reference() and the tables' query frame after the matched submap or frame() changed.
   void refresh();
 

@@ -108,6 +108,8 @@ class LookupTable {
     return std::abs(p.x()) <= kMaxCoordinate && std::abs(p.y()) <= kMaxCoordinate;  // false for NaN
   }
   void buildKernel();
+  /// Cell value at a point in the table's own frame; 0 outside the table.
+  std::uint8_t valueInTable(const Eigen::Vector2d& point) const;
   struct Box {
     long min_x = 0, max_x = -1, min_y = 0, max_y = -1;
   };
