@@ -76,8 +76,7 @@ void LocalMap::refresh() {
   Submap& matched = submaps_.front();
   const Pose2D to_frame = frame_.inverse() * matched.anchor;
   const ReferencePoints& points = matched.points;
-  reference_.points.reserve(points.size());
-  for (const Eigen::Vector2d& point : points.points) reference_.points.push_back(to_frame * point);
+  transformPoints(points.points, to_frame, &reference_.points);
   reference_.scan_starts = points.scan_starts;
   reference_.scan_steps = points.scan_steps;  // angles between beams: the same in any frame
   for (const Eigen::Vector2d& origin : points.scan_origins)

@@ -1,5 +1,7 @@
 #include "hglasm_odometry/core/mbicp.h"
 
+#include "hglasm_odometry/core/fast_math.h"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -104,10 +106,22 @@ void Mbicp::setReference(const ReferencePoints& reference) {
   }
   sortByBearing();
   const double l_sq = options_.metric_l * options_.metric_l;
-  ref_metric_scale_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) ref_metric_scale_[i] = ref_points_[i].squaredNorm() + l_sq;
-  segment_seen_.assign(n, 0u);
-  walk_id_ = 0;
+  walk_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const int j = sorted_index_[k];
+    WalkEntry& entry = walk_[k];
+    entry.point = ref_points_[j];
+    entry.metric_inverse = 1.0 / (ref_points_[j].squaredNorm() + l_sq);
+    entry.index = j;
+    entry.has_next = ref_has_next_[j];
+    entry.has_previous = j > 0 && ref_has_next_[j - 1];
+    entry.to_next =
+        entry.has_next ? Eigen::Vector2d(ref_points_[j + 1] - ref_points_[j]) : Eigen::Vector2d::Zero();
+    entry.from_previous =
+        entry.has_previous ? Eigen::Vector2d(ref_points_[j] - ref_points_[j - 1]) : Eigen::Vector2d::Zero();
+    entry.range = ref_points_[j].norm();
+    entry.reach = std::max(entry.to_next.norm(), entry.from_previous.norm());
+  }
 }
 
 void Mbicp::sortByBearing() {
@@ -122,7 +136,7 @@ void Mbicp::sortByBearing() {
   std::vector<std::size_t> bucket(n);
   bucket_first_.assign(buckets + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    bearing[i] = std::atan2(ref_points_[i].y(), ref_points_[i].x());
+    bearing[i] = fastAtan2(ref_points_[i].y(), ref_points_[i].x());
     // The bucket whose edges hold the bearing, exactly as the edges are computed.
     auto k = static_cast<std::size_t>(
         std::clamp((bearing[i] + M_PI) / (2.0 * M_PI) * buckets, 0.0, static_cast<double>(buckets)));
@@ -161,40 +175,50 @@ void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
   }
 }
 
-inline void Mbicp::considerPoint(const Eigen::Vector2d& p, int j, double, Candidate* candidate) const {
-  // dapSquared() with the point's |q|^2 + L^2 precomputed.
-  const Eigen::Vector2d& q = ref_points_[j];
-  const Eigen::Vector2d d = p - q;
-  const double cross = d.x() * q.y() - d.y() * q.x();
-  const double d_sq = d.squaredNorm() - cross * cross / ref_metric_scale_[j];
+inline void Mbicp::considerPoint(const Eigen::Vector2d& p, const WalkEntry& entry,
+                                 Candidate* candidate) const {
+  // dapSquared() with the point's 1 / (|q|^2 + L^2) precomputed.
+  const Eigen::Vector2d d = p - entry.point;
+  const double cross = d.x() * entry.point.y() - d.y() * entry.point.x();
+  const double d_sq = d.squaredNorm() - cross * cross * entry.metric_inverse;
   if (d_sq < candidate->best) {
     candidate->best = d_sq;
-    candidate->element = j;
+    candidate->element = entry.index;
     candidate->segment = false;
-    candidate->target = q;
+    candidate->target = entry.point;
   }
 }
 
-inline void Mbicp::considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double u_scale,
+inline void Mbicp::considerSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& q,
+                                   const Eigen::Vector2d& e, int j, double l_sq, double u_scale,
                                    Candidate* candidate) const {
-  // Closest point of segment j -> j+1 under the metric, with the metric frozen at p (it varies slowly):
-  // minimise (a - t e)^T M (a - t e), M = I - u u^T / (|p|^2 + L^2), u = (p_y, -p_x).
+  // Closest point of segment q -> q + e (reference segment j) under the metric, with the metric frozen at
+  // p (it varies slowly): minimise (a - t e)^T M (a - t e), M = I - u u^T / (|p|^2 + L^2), u = (p_y, -p_x).
   const Eigen::Vector2d u(p.y(), -p.x());
-  const Eigen::Vector2d& q = ref_points_[j];
-  const Eigen::Vector2d e = ref_points_[j + 1] - q;
   const Eigen::Vector2d a = p - q;
   const double ue = u.dot(e), ua = u.dot(a);
   const double eme = e.squaredNorm() - ue * ue * u_scale;
   if (!(eme > 0.0)) return;
-  const double t = (e.dot(a) - ue * ua * u_scale) / eme;
-  if (t <= 0.0 || t >= 1.0) return;  // the end points are candidates of their own
-  const Eigen::Vector2d on_segment = q + t * e;
+  const double along = e.dot(a) - ue * ua * u_scale;
+  if (along <= 0.0 || along >= eme) return;  // the end points are candidates of their own
+  const Eigen::Vector2d on_segment = q + (along / eme) * e;
   const double d_sq = dapSquared(p, on_segment, l_sq);
   if (d_sq < candidate->best) {
     candidate->best = d_sq;
     candidate->element = j;
     candidate->segment = true;
     candidate->target = on_segment;
+  }
+}
+
+inline void Mbicp::considerEntry(const Eigen::Vector2d& p, const WalkEntry& entry, double l_sq,
+                                 double u_scale, Candidate* candidate) const {
+  considerPoint(p, entry, candidate);
+  // Both segments of the point; a segment met again from its other end point cannot change the best.
+  if (entry.has_next) considerSegment(p, entry.point, entry.to_next, entry.index, l_sq, u_scale, candidate);
+  if (entry.has_previous) {
+    considerSegment(p, entry.point - entry.from_previous, entry.from_previous, entry.index - 1, l_sq, u_scale,
+                    candidate);
   }
 }
 
@@ -228,73 +252,84 @@ int Mbicp::walkStart(double bearing) const {
   return k;
 }
 
-void Mbicp::associatePoint(const Eigen::Vector2d& p, double gate_sq, Candidate* candidate) {
+void Mbicp::associatePoint(const Eigen::Vector2d& p, double gate_sq, int warm_entry, Candidate* candidate) {
   const double l_sq = options_.metric_l * options_.metric_l;
   const double window = std::min(options_.bearing_window, M_PI);
   const double u_scale = 1.0 / (p.squaredNorm() + l_sq);
   double& best = candidate->best;
   best = gate_sq;
-  if (++walk_id_ == 0) {
-    std::fill(segment_seen_.begin(), segment_seen_.end(), 0u);
-    walk_id_ = 1;
-  }
+  const int n = static_cast<int>(sorted_bearing_.size());
+  // The entry of the last iteration first: the estimate moved little since, so it sets a tight best and
+  // the walk below stops within a few points.
+  if (warm_entry >= 0 && warm_entry < n) considerEntry(p, walk_[warm_entry], l_sq, u_scale, candidate);
   // Walk outward in bearing from p's own bearing, both ways, within the window (wrapping at +-pi for
   // 360-degree scans). A reference point at bearing offset D is at least |p| sin D away from p, and
   // d_ap^2 >= |d|^2 L^2 / ((|p| + |d|)^2 + L^2), which grows with |d|: once that bound exceeds the
-  // best candidate so far, nothing farther in bearing can win, and the walk stops.
-  const double bearing = std::atan2(p.y(), p.x());
+  // best candidate so far, nothing farther in bearing can win, and the walk stops. Bearings are
+  // approximations (fastAtan2): the reach is widened by twice their error.
+  const double bearing = fastAtan2(p.y(), p.x());
   const double range = p.norm();
-  const int n = static_cast<int>(sorted_bearing_.size());
   const int start = walkStart(bearing);
   double reach = window;
   double reach_best = -1.0;
+  double d_min = HUGE_VAL;  // no element farther than this from p can win
   auto update_reach = [&]() {
     // Smallest |d| whose bound reaches `best`: root of d^2 (L^2 - best) - 2 best |p| d - best (|p|^2 + L^2).
     reach_best = best;
     const double denominator = l_sq - best;
     if (!(denominator > 0.0) || !(range > 0.0)) {
       reach = window;
+      d_min = HUGE_VAL;
       return;
     }
-    const double d_min = (best * range + std::sqrt(best * best * range * range +
-                                                   denominator * best * (range * range + l_sq))) /
-                         denominator;
-    reach = d_min >= range ? window : std::min(window, std::asin(d_min / range));
+    d_min = (best * range +
+             std::sqrt(best * best * range * range + denominator * best * (range * range + l_sq))) /
+            denominator;
+    if (d_min >= range) {
+      reach = window;
+      return;
+    }
+    // asin(s) <= tan(asin(s)) = s / sqrt(1 - s^2): a slightly wider, still valid reach without asin.
+    const double sine = d_min / range;
+    reach = std::min(window, sine / std::sqrt(1.0 - sine * sine) + 2.0 * kFastAtan2Error);
   };
-  // A segment is considered from either end point, once (a second time could not change the best).
-  const auto segment = [&](int j) {
-    if (!ref_has_next_[j] || segment_seen_[j] == walk_id_) return;
-    segment_seen_[j] = walk_id_;
-    considerSegment(p, j, l_sq, u_scale, candidate);
-  };
-  auto visit = [&](int j) {
-    considerPoint(p, j, l_sq, candidate);
-    segment(j);
-    if (j > 0) segment(j - 1);
+  int best_entry = -1;
+  auto visit = [&](int k) {
+    // An entry whose point and segments all lie farther from p than d_min in range alone cannot win.
+    const WalkEntry& entry = walk_[k];
+    if (std::abs(entry.range - range) > d_min + entry.reach) return;
+    const int before = candidate->element;
+    const bool before_segment = candidate->segment;
+    considerEntry(p, entry, l_sq, u_scale, candidate);
+    if (candidate->element != before || candidate->segment != before_segment) best_entry = k;
     // The reach from a larger `best` is still a valid (looser) bound: refresh only on a real gain.
     if (best < 0.5 * reach_best) update_reach();
   };
+  if (candidate->element >= 0) best_entry = warm_entry;
   update_reach();
   for (int step = 0; step < n; ++step) {  // counter-clockwise
     int k = start + step;
     double offset = (k >= n ? sorted_bearing_[k -= n] + 2.0 * M_PI : sorted_bearing_[k]) - bearing;
     if (offset > reach) break;
-    visit(sorted_index_[k]);
+    visit(k);
   }
   for (int step = 1; step < n; ++step) {  // clockwise
     int k = start - step;
     double offset = bearing - (k < 0 ? sorted_bearing_[k += n] - 2.0 * M_PI : sorted_bearing_[k]);
     if (offset > reach) break;
-    visit(sorted_index_[k]);
+    visit(k);
   }
+  candidate->entry = best_entry;
 }
 
 void Mbicp::associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out) {
   out->clear();
-  for (const auto& p : moved) {
+  warm_entry_.resize(moved.size(), -1);
+  for (std::size_t i = 0; i < moved.size(); ++i) {
     Candidate candidate;
-    associatePoint(p, gate * gate, &candidate);
-    if (candidate.element >= 0) out->push_back(associationOf(p, candidate));
+    associatePoint(moved[i], gate * gate, warm_entry_[i], &candidate);
+    warm_entry_[i] = candidate.entry;
+    if (candidate.element >= 0) out->push_back(associationOf(moved[i], candidate));
   }
 }
 
@@ -326,8 +361,8 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial, const PosePrio
   result.covariance = Eigen::Matrix3d::Identity() * kMaxVariance;
   if (prior && !(prior->mean.isFinite() && prior->information.allFinite())) prior = nullptr;
 
-  std::vector<Eigen::Vector2d> points;
-  points.reserve(scan.points.size());
+  std::vector<Eigen::Vector2d>& points = points_;
+  points.clear();
   for (const auto& p : scan.points) {
     if (p.allFinite()) points.push_back(p);
   }
@@ -344,6 +379,7 @@ MbicpResult Mbicp::match(const Scan& scan, const Pose2D& initial, const PosePrio
   bool settled = fine_gate == options_.max_distance;
   result.status = MbicpStatus::kMaxIterations;
   moved_.resize(points.size());
+  warm_entry_.assign(points.size(), -1);
 
   for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
     result.iterations = iteration;

@@ -1,5 +1,7 @@
 #include "hglasm_odometry/core/polar_pairing.h"
 
+#include "hglasm_odometry/core/fast_math.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -12,21 +14,6 @@ constexpr double kTwoPi = 2.0 * M_PI;
 constexpr double kMinStep = 1e-4;
 // Reference points this close to the sensor have no meaningful polar angle.
 constexpr double kMinRange = 1e-6;
-
-// atan2 within about 1e-5 rad (the polynomial of Abramowitz & Stegun 4.4.49 on [0, 1], unfolded into the
-// octants): far finer than an angular step, and std::atan2 would otherwise be most of an evaluation's cost.
-float fastAtan2(float y, float x) {
-  const float ax = std::abs(x), ay = std::abs(y);
-  const float big = std::max(ax, ay);
-  // At the origin any angle will do (0); branch-free so that the caller's loop vectorises.
-  const float z = std::min(ax, ay) / (big > 0.0f ? big : 1.0f);
-  const float z2 = z * z;
-  float angle =
-      z * (0.9998660f + z2 * (-0.3302995f + z2 * (0.1801410f + z2 * (-0.0851330f + z2 * 0.0208351f))));
-  angle = ay > ax ? static_cast<float>(M_PI_2) - angle : angle;
-  angle = x < 0.0f ? static_cast<float>(M_PI) - angle : angle;
-  return y < 0.0f ? -angle : angle;
-}
 
 }  // namespace
 

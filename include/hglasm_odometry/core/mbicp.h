@@ -145,15 +145,32 @@ class Mbicp {
     int element = -1;  // reference point, or segment from it to the next; -1: none yet
     bool segment = false;
     Eigen::Vector2d target;  // the point on the element
+    int entry = -1;          // the walk entry it was found at (the next iteration starts there)
+  };
+  /// A reference point in bearing order with its two segments, so that the walk reads memory in sequence.
+  struct WalkEntry {
+    Eigen::Vector2d point;
+    Eigen::Vector2d to_next;        // segment index -> index + 1 (if has_next)
+    Eigen::Vector2d from_previous;  // segment index - 1 -> index (if has_previous)
+    double metric_inverse = 0.0;    // 1 / (|point|^2 + L^2)
+    double range = 0.0;             // |point|
+    double reach = 0.0;             // the longer of its two segments
+    int index = 0;                  // into ref_points_
+    bool has_next = false;
+    bool has_previous = false;
   };
   /// The association of p with its candidate's element.
   Association associationOf(const Eigen::Vector2d& p, const Candidate& candidate) const;
-  void considerPoint(const Eigen::Vector2d& p, int j, double l_sq, Candidate* candidate) const;
+  void considerPoint(const Eigen::Vector2d& p, const WalkEntry& entry, Candidate* candidate) const;
   /// u_scale: 1 / (|p|^2 + L^2), the metric frozen at p.
-  void considerSegment(const Eigen::Vector2d& p, int j, double l_sq, double u_scale,
-                       Candidate* candidate) const;
-  /// The best association of one point (its bearing walk).
-  void associatePoint(const Eigen::Vector2d& p, double gate_sq, Candidate* candidate);
+  void considerSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& e, int j,
+                       double l_sq, double u_scale, Candidate* candidate) const;
+  /// The entry's point and both its segments.
+  void considerEntry(const Eigen::Vector2d& p, const WalkEntry& entry, double l_sq, double u_scale,
+                     Candidate* candidate) const;
+  /// The best association of one point (its bearing walk), starting from `warm_element` (the element of the
+  /// last iteration's walk entry, -1: none).
+  void associatePoint(const Eigen::Vector2d& p, double gate_sq, int warm_entry, Candidate* candidate);
   /// The first index of sorted_bearing_ not below `bearing` (std::lower_bound).
   int walkStart(double bearing) const;
   void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out);
@@ -181,13 +198,13 @@ class Mbicp {
   std::vector<double> sorted_bearing_;         // bearings of reference points, ascending
   std::vector<int> sorted_index_;              // their indices into ref_points_
   std::vector<int> bucket_first_;  // first sorted index of each of n equal bearing buckets (n + 1 entries)
-  std::vector<double> ref_metric_scale_;     // |q|^2 + L^2 of each point (d_ap's denominator)
-  std::vector<std::uint32_t> segment_seen_;  // per segment: the last point whose walk considered it
-  std::uint32_t walk_id_ = 0;
+  std::vector<WalkEntry> walk_;    // the reference points in the order of sorted_bearing_
   std::vector<Association> associations_;                       // scratch
   Eigen::Matrix3d scan_information_ = Eigen::Matrix3d::Zero();  // of the last step, increment coordinates
   ScanNoiseScale scan_noise_scale_ = ScanNoiseScale::Ones();
-  std::vector<Eigen::Vector2d> moved_;  // scratch
+  std::vector<Eigen::Vector2d> moved_;   // scratch
+  std::vector<Eigen::Vector2d> points_;  // scratch: the scan's points matched
+  std::vector<int> warm_entry_;          // per point: the walk entry of its last association (-1: none)
 };
 
 }  // namespace hglasm
