@@ -12,26 +12,43 @@ LocalMap::LocalMap(const LocalMapOptions& options, const std::vector<LookupTable
 
 void LocalMap::add(const Pose2D& laser_pose, const std::vector<Eigen::Vector2d>& points) {
   ++revision_;
-  frame_ = laser_pose;
   // A new submap starts when the newer one is full; the older (matched) one goes when a third would start.
+  bool matched_changed = submaps_.empty();
   if (submaps_.empty() || submaps_.back().keyframes >= options_.keyframes) {
-    if (submaps_.size() >= 2) submaps_.pop_front();
+    if (submaps_.size() >= 2) {
+      submaps_.pop_front();
+      matched_changed = true;
+    }
     submaps_.emplace_back();
     Submap& started = submaps_.back();
     started.anchor = laser_pose;
     for (const LookupTableOptions& table : table_options_) started.tables.emplace_back(table);
   }
+  const std::size_t matched_scans = submaps_.front().points.scan_starts.size();
   for (Submap& submap : submaps_) insert(&submap, laser_pose, points);
   while (submaps_.size() > 1 &&
          (submaps_.front().anchor.translation() - laser_pose.translation()).norm() > options_.max_distance) {
     submaps_.pop_front();
+    matched_changed = true;
   }
-  refresh();
+  // MbICP's metric wants the sensor near the frame's origin: the frame follows the keyframes, but only
+  // every reframe_distance, so that most keyframes extend the reference instead of rebuilding it.
+  const bool reframe = matched_changed || !(options_.reframe_distance > 0.0) ||
+                       (laser_pose.translation() - frame_.translation()).norm() >= options_.reframe_distance;
+  if (reframe) {
+    frame_ = laser_pose;
+    refresh();
+    unchanged_scans_ = 0;
+  } else {
+    unchanged_scans_ = reference_.scan_starts.size();
+    if (submaps_.front().points.scan_starts.size() > matched_scans) appendNewest();
+  }
 }
 
 void LocalMap::clear() {
   submaps_.clear();
   reference_.clear();
+  unchanged_scans_ = 0;
   frame_ = Pose2D();
   ++revision_;
 }
@@ -83,6 +100,21 @@ void LocalMap::refresh() {
     reference_.scan_origins.push_back(to_frame * origin);
   const Pose2D query_in_table = to_frame.inverse();
   for (LookupTable& table : matched.tables) table.setQueryFrame(query_in_table);
+}
+
+void LocalMap::appendNewest() {
+  const Submap& matched = submaps_.front();
+  const ReferencePoints& points = matched.points;
+  const std::size_t scan = points.scan_starts.size() - 1;
+  const Pose2D to_frame = frame_.inverse() * matched.anchor;
+  const std::size_t start = points.scan_starts[scan];
+  kept_.assign(points.points.begin() + static_cast<std::ptrdiff_t>(start), points.points.end());
+  transformPoints(kept_, to_frame, &added_.points);
+  reference_.appendMoved(added_.points, to_frame * points.scanOrigin(scan));
+  // The step as refresh() copies it (the same angle, computed once in the submap's frame).
+  if (scan < points.scan_steps.size() && reference_.scan_steps.size() == reference_.scan_starts.size()) {
+    reference_.scan_steps.back() = points.scan_steps[scan];
+  }
 }
 
 std::uint64_t LocalMap::cellKey(const Eigen::Vector2d& point, int dx, int dy) const {

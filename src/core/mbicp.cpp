@@ -72,28 +72,52 @@ void Mbicp::setReference(const Scan& reference) {
 
 void Mbicp::setReference(const ReferencePoints& reference) {
   ref_points_.clear();
-  // The finite points, each with its index in `reference` and the scan it came from.
-  std::vector<std::size_t> kept_index, scan_of_point;
-  const std::vector<std::uint8_t> same_scan_as_next = reference.sameScanAsNext();
-  std::size_t scan = 0;
-  for (std::size_t i = 0; i < reference.size(); ++i) {
-    if (reference.points[i].allFinite()) {
-      ref_points_.push_back(reference.points[i]);
-      kept_index.push_back(i);
-      scan_of_point.push_back(scan);
+  ref_has_next_.clear();
+  ref_normals_.clear();
+  ref_tangents_.clear();
+  ref_sampling_variance_.clear();
+  appendScans(reference, 0);
+  sortByBearing();
+}
+
+void Mbicp::extendReference(const ReferencePoints& reference, std::size_t first_new_scan) {
+  if (first_new_scan == 0 || ref_points_.empty()) {
+    setReference(reference);
+    return;
+  }
+  const std::size_t old_count = ref_points_.size();
+  appendScans(reference, first_new_scan);
+  mergeByBearing(old_count);
+}
+
+void Mbicp::appendScans(const ReferencePoints& reference, std::size_t first_scan) {
+  const std::size_t first_new = ref_points_.size();
+  // Segments join neighbouring beams of one surface (never two scans, never across a missing beam).
+  const std::vector<std::uint8_t> joins = joinSurfaces(
+      reference, SurfaceOptions{options_.segment_max_gap, options_.segment_max_incidence}, first_scan);
+  for (std::size_t scan = first_scan; scan < reference.scan_starts.size(); ++scan) {
+    const Eigen::Vector2d origin = reference.scanOrigin(scan);
+    const double step = angularStep(reference, scan);
+    std::size_t previous = reference.points.size();  // the scan's last finite point so far
+    for (std::size_t i = reference.scan_starts[scan]; i < reference.scanEnd(scan); ++i) {
+      const Eigen::Vector2d& point = reference.points[i];
+      if (!point.allFinite()) continue;
+      if (previous + 1 == i && joins[previous]) ref_has_next_.back() = 1;
+      previous = i;
+      ref_points_.push_back(point);
+      ref_has_next_.push_back(0);
+      // The surface the beam hit lies anywhere in the beam's angular cell: uniform over range * step.
+      const Eigen::Vector2d beam = point - origin;
+      const double range = beam.norm();
+      const bool sampled = range > 0.0;
+      ref_tangents_.push_back(sampled ? Eigen::Vector2d(Eigen::Vector2d(-beam.y(), beam.x()) / range)
+                                      : Eigen::Vector2d::Zero());
+      ref_sampling_variance_.push_back(sampled ? range * step * range * step / 12.0 : 0.0);
     }
-    if (!same_scan_as_next[i]) ++scan;
   }
   const std::size_t n = ref_points_.size();
-  // Segments join neighbouring beams of one surface (never two scans, never across a missing beam).
-  const std::vector<std::uint8_t> joins =
-      joinSurfaces(reference, SurfaceOptions{options_.segment_max_gap, options_.segment_max_incidence});
-  ref_has_next_.assign(n, 0);
-  for (std::size_t i = 0; i + 1 < n; ++i)
-    ref_has_next_[i] = kept_index[i + 1] == kept_index[i] + 1 && joins[kept_index[i]];
-  computeSamplingUncertainty(reference, scan_of_point);
-  ref_normals_.assign(n, Eigen::Vector2d::Zero());
-  for (std::size_t i = 0; i < n; ++i) {
+  ref_normals_.resize(n, Eigen::Vector2d::Zero());
+  for (std::size_t i = first_new; i < n; ++i) {
     const bool has_prev = i > 0 && ref_has_next_[i - 1];
     const bool has_next = ref_has_next_[i];
     if (has_prev && has_next) {
@@ -104,24 +128,23 @@ void Mbicp::setReference(const ReferencePoints& reference) {
       ref_normals_[i] = unitNormal(ref_points_[i] - ref_points_[i - 1]);
     }
   }
-  sortByBearing();
+}
+
+Mbicp::WalkEntry Mbicp::walkEntry(int j) const {
   const double l_sq = options_.metric_l * options_.metric_l;
-  walk_.resize(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    const int j = sorted_index_[k];
-    WalkEntry& entry = walk_[k];
-    entry.point = ref_points_[j];
-    entry.metric_inverse = 1.0 / (ref_points_[j].squaredNorm() + l_sq);
-    entry.index = j;
-    entry.has_next = ref_has_next_[j];
-    entry.has_previous = j > 0 && ref_has_next_[j - 1];
-    entry.to_next =
-        entry.has_next ? Eigen::Vector2d(ref_points_[j + 1] - ref_points_[j]) : Eigen::Vector2d::Zero();
-    entry.from_previous =
-        entry.has_previous ? Eigen::Vector2d(ref_points_[j] - ref_points_[j - 1]) : Eigen::Vector2d::Zero();
-    entry.range = ref_points_[j].norm();
-    entry.reach = std::max(entry.to_next.norm(), entry.from_previous.norm());
-  }
+  WalkEntry entry;
+  entry.point = ref_points_[j];
+  entry.metric_inverse = 1.0 / (ref_points_[j].squaredNorm() + l_sq);
+  entry.index = j;
+  entry.has_next = ref_has_next_[j];
+  entry.has_previous = j > 0 && ref_has_next_[j - 1];
+  entry.to_next =
+      entry.has_next ? Eigen::Vector2d(ref_points_[j + 1] - ref_points_[j]) : Eigen::Vector2d::Zero();
+  entry.from_previous =
+      entry.has_previous ? Eigen::Vector2d(ref_points_[j] - ref_points_[j - 1]) : Eigen::Vector2d::Zero();
+  entry.range = ref_points_[j].norm();
+  entry.reach = std::max(entry.to_next.norm(), entry.from_previous.norm());
+  return entry;
 }
 
 void Mbicp::sortByBearing() {
@@ -154,24 +177,56 @@ void Mbicp::sortByBearing() {
               [&](int x, int y) { return bearing[x] < bearing[y] || (bearing[x] == bearing[y] && x < y); });
   }
   sorted_bearing_.resize(n);
-  for (std::size_t k = 0; k < n; ++k) sorted_bearing_[k] = bearing[sorted_index_[k]];
+  walk_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    sorted_bearing_[k] = bearing[sorted_index_[k]];
+    walk_[k] = walkEntry(sorted_index_[k]);
+  }
 }
 
-void Mbicp::computeSamplingUncertainty(const ReferencePoints& reference,
-                                       const std::vector<std::size_t>& scan_of_point) {
+void Mbicp::mergeByBearing(std::size_t old_count) {
+  // The new points sorted by (bearing, index), merged with the sorted old ones: the order a full sort of
+  // all of them gives, in time linear in the old ones.
   const std::size_t n = ref_points_.size();
-  ref_tangents_.assign(n, Eigen::Vector2d::Zero());
-  ref_sampling_variance_.assign(n, 0.0);
-  std::vector<double> step(reference.scan_starts.size());
-  for (std::size_t scan = 0; scan < step.size(); ++scan) step[scan] = angularStep(reference, scan);
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t scan = scan_of_point[i];
-    const Eigen::Vector2d beam = ref_points_[i] - reference.scanOrigin(scan);
-    const double range = beam.norm();
-    if (!(range > 0.0) || scan >= step.size()) continue;
-    ref_tangents_[i] = Eigen::Vector2d(-beam.y(), beam.x()) / range;
-    // The surface the beam hit lies anywhere in the beam's angular cell: uniform over range * step.
-    ref_sampling_variance_[i] = range * step[scan] * range * step[scan] / 12.0;
+  std::vector<std::pair<double, int>> added;
+  added.reserve(n - old_count);
+  for (std::size_t i = old_count; i < n; ++i) {
+    added.emplace_back(fastAtan2(ref_points_[i].y(), ref_points_[i].x()), static_cast<int>(i));
+  }
+  std::sort(added.begin(), added.end());
+  std::vector<int> index;
+  std::vector<double> bearing;
+  std::vector<WalkEntry> walk;
+  index.reserve(n);
+  bearing.reserve(n);
+  walk.reserve(n);
+  std::size_t a = 0, b = 0;
+  while (a < old_count || b < added.size()) {
+    // Old indices are all smaller than new ones: at equal bearings the old point comes first.
+    const bool take_old = b == added.size() || (a < old_count && sorted_bearing_[a] <= added[b].first);
+    if (take_old) {
+      index.push_back(sorted_index_[a]);
+      bearing.push_back(sorted_bearing_[a]);
+      walk.push_back(walk_[a]);
+      ++a;
+    } else {
+      index.push_back(added[b].second);
+      bearing.push_back(added[b].first);
+      walk.push_back(walkEntry(added[b].second));
+      ++b;
+    }
+  }
+  sorted_index_.swap(index);
+  sorted_bearing_.swap(bearing);
+  walk_.swap(walk);
+  // Each of the n equal buckets starts at the first point at or past its lower edge.
+  const std::size_t buckets = std::max<std::size_t>(n, 1);
+  bucket_first_.assign(buckets + 1, static_cast<int>(n));
+  std::size_t k = 0;
+  for (std::size_t bucket = 0; bucket <= buckets; ++bucket) {
+    const double edge = -M_PI + 2.0 * M_PI * static_cast<double>(bucket) / static_cast<double>(buckets);
+    while (k < n && sorted_bearing_[k] < edge) ++k;
+    bucket_first_[bucket] = static_cast<int>(bucket == buckets ? n : k);
   }
 }
 

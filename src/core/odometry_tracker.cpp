@@ -634,7 +634,7 @@ void OdometryTracker::addKeyframe(const Scan& scan) {
   if (local_map_.tableCount() >= 2) {
     matcher_.useTables(&local_map_.table(kFineTable), &local_map_.table(kCoarseTable));
   }
-  matcher_.setReference(local_map_.reference());
+  matcher_.extendReference(local_map_.reference(), local_map_.unchangedScans());
   table_build_ms_ = millisecondsSince(start);
   // The pose's uncertainty relative to the map stays; only the frame it is expressed in turns.
   map_covariance_ = had_map ? rotateCovariance(relativePose(local_map_.frame(), old_frame), map_covariance_)

@@ -144,13 +144,14 @@ void ReferencePoints::appendMoved(const std::vector<Eigen::Vector2d>& moved_poin
   addScan(this, start, origin);
 }
 
-std::vector<std::uint8_t> joinSurfaces(const ReferencePoints& reference, const SurfaceOptions& options) {
+std::vector<std::uint8_t> joinSurfaces(const ReferencePoints& reference, const SurfaceOptions& options,
+                                       std::size_t first_scan) {
   const std::vector<Eigen::Vector2d>& points = reference.points;
   std::vector<std::uint8_t> joins(points.size(), 0);
   if (!(options.max_gap > 0.0)) return joins;
   const double incidence = options.max_incidence;
   const double oblique = incidence > 0.0 && incidence < 0.5 * M_PI ? 1.0 / std::cos(incidence) : 0.0;
-  for (std::size_t scan = 0; scan < reference.scan_starts.size(); ++scan) {
+  for (std::size_t scan = first_scan; scan < reference.scan_starts.size(); ++scan) {
     const Eigen::Vector2d origin = reference.scanOrigin(scan);
     // Capped: a scan of a few scattered points has no beam spacing (no 2D laser is coarser than ~1 deg).
     const double step_gap = std::min(angularStep(reference, scan), kMaxJoinStep) * oblique;

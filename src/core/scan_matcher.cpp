@@ -164,6 +164,17 @@ void ScanMatcher::setReference(const ReferencePoints& reference) {
   has_reference_ = !reference.empty();
 }
 
+void ScanMatcher::extendReference(const ReferencePoints& reference, std::size_t first_new_scan) {
+  if (first_new_scan == 0 || !external_fine_ || usesPolarPairing(options_.algorithm)) {
+    setReference(reference);
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  mbicp_.extendReference(reference, first_new_scan);
+  table_build_ms_ = millisecondsSince(start);
+  has_reference_ = !reference.empty();
+}
+
 bool ScanMatcher::startResult(const Scan& scan, const Pose2D& guess, MatchResult* result) const {
   result->pose = result->prealigned_pose = guess.isFinite() ? guess : Pose2D();
   // Without a trustworthy estimate the covariance says so (finite, large).

@@ -344,6 +344,7 @@ void visitTrackerOptions(Params& tree, hglasm::TrackerOptions* options) {
   tree.positiveInteger("local_map/keyframes", &tracker.local_map.keyframes);
   tree.positiveNumber("local_map/max_distance", &tracker.local_map.max_distance);
   tree.nonNegativeNumber("local_map/resolution", &tracker.local_map.resolution);
+  tree.nonNegativeNumber("local_map/reframe_distance", &tracker.local_map.reframe_distance);
 }
 
 /// Wheel odometry as the prediction, and its noise.

@@ -29,6 +29,10 @@ struct LocalMapOptions {
   /// keyframes overlap the scan is matched to the oldest view (the anchor that drifted least). 0 keeps
   /// every point.
   double resolution = 0.03;
+  /// Metres: the frame the map is expressed in (the origin of MbICP's metric and of its bearing search) moves
+  /// to the newest keyframe once that is this far from it, or when the matched submap changes; in between,
+  /// a keyframe only adds its points. 0: every keyframe moves it.
+  double reframe_distance = 1.0;
 };
 
 /// Keyframes (points in their laser frame, laser pose in the odometry frame) gathered into submaps, each in
@@ -48,10 +52,14 @@ class LocalMap {
   bool empty() const { return submaps_.empty(); }
   /// Keyframes of the submap scans are matched against.
   std::size_t keyframeCount() const { return submaps_.empty() ? 0 : submaps_.front().keyframes; }
-  /// The newest keyframe's laser pose in the odometry frame: the frame reference() is expressed in.
+  /// The laser pose (odometry frame) of a recent keyframe, within reframe_distance of the newest: the frame
+  /// reference() is expressed in.
   const Pose2D& frame() const { return frame_; }
   /// The matched submap's points in frame(), one scan per keyframe.
   const ReferencePoints& reference() const { return reference_; }
+  /// Scans of reference() unchanged by the last add() (same frame, same points): the rest are new. 0 after
+  /// a change of frame or of the matched submap.
+  std::size_t unchangedScans() const { return unchanged_scans_; }
   /// Lookup table `index` (as given to the constructor) of the matched submap, answering in frame().
   const LookupTable& table(std::size_t index) const;
   std::size_t tableCount() const { return table_options_.size(); }
@@ -79,6 +87,8 @@ class LocalMap {
   }
   /// reference() and the tables' query frame after the matched submap or frame() changed.
   void refresh();
+  /// Appends to reference() what the last insert kept in the matched submap (frame() unchanged).
+  void appendNewest();
 
   LocalMapOptions options_;
   std::vector<LookupTableOptions> table_options_;
@@ -86,6 +96,7 @@ class LocalMap {
   Pose2D frame_;
   ReferencePoints reference_;
   std::uint64_t revision_ = 0;
+  std::size_t unchanged_scans_ = 0;
   LookupTable empty_table_;
   ReferencePoints added_;              // scratch: the keyframe's kept points as one scan
   std::vector<Eigen::Vector2d> kept_;  // scratch: in the keyframe's frame

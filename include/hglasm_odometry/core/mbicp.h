@@ -100,6 +100,10 @@ class Mbicp {
   void setReference(const Scan& reference);
   /// Several scans in one frame (a local map): segments join consecutive points of one scan only.
   void setReference(const ReferencePoints& reference);
+  /// The same after scans were appended to the reference given last: its scans before `first_new_scan` are
+  /// unchanged (same frame, same points), the rest are new. The result is that of setReference(reference),
+  /// in time linear in the old points instead of a rebuild. 0: setReference().
+  void extendReference(const ReferencePoints& reference, std::size_t first_new_scan);
   bool hasReference() const { return !ref_points_.empty(); }
 
   /// Refines `initial` (new scan in the reference frame). With a `prior` the result is the maximum a
@@ -125,11 +129,13 @@ class Mbicp {
     double sampling_variance;
     double weight;  // robust weight of the last step (1 without robust_scale)
   };
-  /// Per kept reference point: the direction across its beam and the variance of its sampling along it.
-  /// sorted_index_, sorted_bearing_ and bucket_first_ of the reference points.
+  /// The finite points of `reference`'s scans from `first_scan` on, with their segments, normals and
+  /// sampling (the direction across each beam and the variance of where along it the surface was hit).
+  void appendScans(const ReferencePoints& reference, std::size_t first_scan);
+  /// sorted_index_, sorted_bearing_, bucket_first_ and walk_ of all reference points.
   void sortByBearing();
-  void computeSamplingUncertainty(const ReferencePoints& reference,
-                                  const std::vector<std::size_t>& scan_of_point);
+  /// The same after the points from `old_count` on were appended to sorted ones.
+  void mergeByBearing(std::size_t old_count);
   /// Convergence bookkeeping of the settled iterations.
   struct Progress {
     double previous_error = -1.0;
@@ -159,6 +165,7 @@ class Mbicp {
     bool has_next = false;
     bool has_previous = false;
   };
+  WalkEntry walkEntry(int j) const;
   /// The association of p with its candidate's element.
   Association associationOf(const Eigen::Vector2d& p, const Candidate& candidate) const;
   void considerPoint(const Eigen::Vector2d& p, const WalkEntry& entry, Candidate* candidate) const;

@@ -107,8 +107,9 @@ struct SurfaceOptions {
 double angularStep(const ReferencePoints& reference, std::size_t scan);
 
 /// For each point of `reference`: 1 if it and the next point are joined under `options` (same scan, both
-/// finite, the gap small enough), else 0.
-std::vector<std::uint8_t> joinSurfaces(const ReferencePoints& reference, const SurfaceOptions& options);
+/// finite, the gap small enough), else 0. Scans before `first_scan` are left at 0 (not examined).
+std::vector<std::uint8_t> joinSurfaces(const ReferencePoints& reference, const SurfaceOptions& options,
+                                       std::size_t first_scan = 0);
 
 /// Why a RangeScan could not be converted at all (its points are then empty).
 enum class ScanError { kNone, kNoBeams, kBadAngles, kBadRangeLimits };

@@ -114,6 +114,9 @@ class ScanMatcher {
   void setReference(const Scan& reference);
   /// The same from several scans in one frame (a local map).
   void setReference(const ReferencePoints& reference);
+  /// The same after scans were appended to that reference (Mbicp::extendReference): its scans before
+  /// `first_new_scan` are unchanged. With tables kept by the caller (useTables) only MbICP's structure grows.
+  void extendReference(const ReferencePoints& reference, std::size_t first_new_scan);
   bool hasReference() const { return has_reference_; }
   double lastTableBuildMs() const { return table_build_ms_; }
   /// Time the last match() spent building the coarse table (built on first use; 0 if it did not).
