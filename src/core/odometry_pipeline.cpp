@@ -68,7 +68,7 @@ SampleVerdict OdometryPipeline::addOdometry(double stamp, const Pose2D& pose) {
 }
 
 SampleVerdict OdometryPipeline::addImu(double stamp, double value) {
-  if (!tracker_.options().use_imu || !std::isfinite(stamp) || !std::isfinite(value)) {
+  if (!tracker_.options().prediction.use_imu || !std::isfinite(stamp) || !std::isfinite(value)) {
     return SampleVerdict::kInvalid;
   }
   const StampOrder::Verdict verdict = imu_.take(stamp, scan_order_.newest());
@@ -95,12 +95,12 @@ StampOrder::Verdict OdometryPipeline::InputFeed::take(double stamp, double neede
 }
 
 bool OdometryPipeline::wheelsReadyFor(double stamp) const {
-  return !tracker_.options().use_odometry || !wait_for_inputs_ ||
+  return !tracker_.options().prediction.use_odometry || !wait_for_inputs_ ||
          wheels_.readyFor(stamp + tracker_.odometryTimeOffset());
 }
 
 bool OdometryPipeline::imuReadyFor(double stamp) const {
-  return !tracker_.options().use_imu || !wait_for_inputs_ || imu_.readyFor(stamp);
+  return !tracker_.options().prediction.use_imu || !wait_for_inputs_ || imu_.readyFor(stamp);
 }
 
 bool OdometryPipeline::inputsReadyFor(double stamp, double sweep) const {
@@ -174,11 +174,11 @@ PipelineUpdate OdometryPipeline::processScan(double stamp, const RangeScan& rang
   if (result.matched) {
     // The tracker's own conjugation of the predicted base motion by the mount.
     update.laser_guess =
-        base_to_laser_.inverse() * relativePose(keyframe_before, result.guess) * base_to_laser_;
+        base_to_laser_.inverse() * relativePose(keyframe_before, result.diagnostics.guess) * base_to_laser_;
   }
   if (result.new_keyframe) keyframe_pose_ = result.pose;
-  if (tracker_.options().use_imu && result.published && !result.reset) {
-    update.imu_stale = !result.rotation_from_imu;
+  if (tracker_.options().prediction.use_imu && result.published && !result.reset) {
+    update.imu_stale = !result.diagnostics.rotation_from_imu;
     update.imu_stale_changed = update.imu_stale != imu_stale_;
     imu_stale_ = update.imu_stale;
   } else {
