@@ -68,7 +68,7 @@ SampleVerdict OdometryPipeline::addOdometry(double stamp, const Pose2D& pose) {
 }
 
 SampleVerdict OdometryPipeline::addImu(double stamp, double value) {
-  if (!tracker_.options().use_imu || !std::isfinite(stamp) || !std::isfinite(value)) {
+  if (!tracker_.options().prediction.use_imu || !std::isfinite(stamp) || !std::isfinite(value)) {
     return SampleVerdict::kInvalid;
   }
   const StampOrder::Verdict verdict = imu_.take(stamp, scan_order_.newest());
@@ -95,12 +95,12 @@ StampOrder::Verdict OdometryPipeline::InputFeed::take(double stamp, double neede
 }
 
 bool OdometryPipeline::wheelsReadyFor(double stamp) const {
-  return !tracker_.options().use_odometry || !wait_for_inputs_ ||
+  return !tracker_.options().prediction.use_odometry || !wait_for_inputs_ ||
          wheels_.readyFor(stamp + tracker_.odometryTimeOffset());
 }
 
 bool OdometryPipeline::imuReadyFor(double stamp) const {
-  return !tracker_.options().use_imu || !wait_for_inputs_ || imu_.readyFor(stamp);
+  return !tracker_.options().prediction.use_imu || !wait_for_inputs_ || imu_.readyFor(stamp);
 }
 
 bool OdometryPipeline::inputsReadyFor(double stamp, double sweep) const {
@@ -163,8 +163,8 @@ PipelineUpdate OdometryPipeline::processScan(double stamp, const RangeScan& rang
   update.scan_error_changed = update.scan_error != scan_error_;
   scan_error_ = update.scan_error;
 
-  // The keyframe before this scan: the one the guess is relative to.
-  const Pose2D keyframe_before = keyframe_pose_;
+  // The local map's frame the scan is matched in (a keyframe may move it): the one the guess is relative to.
+  const Pose2D map_frame = tracker_.localMap().frame();
   update.tracker = tracker_.processScan(stamp, update.scan, population);
   if (!timeline_warning.empty()) {
     update.tracker.warning =
@@ -173,12 +173,10 @@ PipelineUpdate OdometryPipeline::processScan(double stamp, const RangeScan& rang
   const TrackerUpdate& result = update.tracker;
   if (result.matched) {
     // The tracker's own conjugation of the predicted base motion by the mount.
-    update.laser_guess =
-        base_to_laser_.inverse() * relativePose(keyframe_before, result.guess) * base_to_laser_;
+    update.laser_guess = map_frame.inverse() * result.diagnostics.guess * base_to_laser_;
   }
-  if (result.new_keyframe) keyframe_pose_ = result.pose;
-  if (tracker_.options().use_imu && result.published && !result.reset) {
-    update.imu_stale = !result.rotation_from_imu;
+  if (tracker_.options().prediction.use_imu && result.published && !result.reset) {
+    update.imu_stale = !result.diagnostics.rotation_from_imu;
     update.imu_stale_changed = update.imu_stale != imu_stale_;
     imu_stale_ = update.imu_stale;
   } else {
@@ -187,14 +185,10 @@ PipelineUpdate OdometryPipeline::processScan(double stamp, const RangeScan& rang
   return update;
 }
 
-void OdometryPipeline::reset() {
-  tracker_.reset();
-  keyframe_pose_ = Pose2D();
-}
+void OdometryPipeline::reset() { tracker_.reset(); }
 
 bool OdometryPipeline::setPose(double stamp, const Pose2D& pose, const Eigen::Matrix3d& covariance) {
   if (!tracker_.setPose(stamp, pose, covariance)) return false;
-  keyframe_pose_ = tracker_.pose();
   return true;
 }
 

@@ -18,35 +18,30 @@ const char* toString(PredictionSource source) {
   return "unknown";
 }
 
-PoseExtrapolator::PoseExtrapolator(bool use_odometry, double max_odometry_age, double max_speed,
-                                   double max_turn_rate, bool use_gyro, const GyroOptions& gyro)
-    : use_odometry_(use_odometry),
-      max_odometry_age_(max_odometry_age),
-      max_speed_(max_speed),
-      max_turn_rate_(max_turn_rate),
-      use_gyro_(use_gyro),
-      gyro_(gyro),
-      gyro_bias_variance_(gyro.bias_sigma * gyro.bias_sigma) {}
+PoseExtrapolator::PoseExtrapolator(const PoseExtrapolatorOptions& options)
+    : options_(options),
+      imu_(options.imu),
+      imu_bias_variance_(options.imu.bias_sigma * options.imu.bias_sigma) {}
 
 MotionPrediction PoseExtrapolator::predict(double from, double to, const MotionNoiseModel& noise,
                                            std::string* warning) const {
   MotionPrediction prediction = predictTranslation(from, to, noise, warning);
   prediction.dt = to - from;
-  if (use_gyro_) applyGyro(from, to, &prediction, warning);
+  if (options_.use_imu) applyImu(from, to, &prediction, warning);
   return prediction;
 }
 
-bool PoseExtrapolator::gyroRotation(double from, double to, double* angle) const {
+bool PoseExtrapolator::imuRotation(double from, double to, double* angle) const {
   double raw_angle = 0.0;
-  if (!use_gyro_ || !gyro_.rotation(from, to, &raw_angle)) return false;
-  *angle = raw_angle - gyro_bias_ * (to - from);
+  if (!options_.use_imu || !imu_.rotation(from, to, &raw_angle)) return false;
+  *angle = raw_angle - imu_bias_ * (to - from);
   return true;
 }
 
-void PoseExtrapolator::applyGyro(double from, double to, MotionPrediction* prediction,
-                                 std::string* warning) const {
+void PoseExtrapolator::applyImu(double from, double to, MotionPrediction* prediction,
+                                std::string* warning) const {
   double angle = 0.0;
-  if (!gyroRotation(from, to, &angle)) return;
+  if (!imuRotation(from, to, &angle)) return;
   const double dt = to - from;
   if (!plausibleTurn(angle, dt)) {
     std::ostringstream text;
@@ -62,19 +57,19 @@ void PoseExtrapolator::applyGyro(double from, double to, MotionPrediction* predi
                               s * prediction->motion.x + c * prediction->motion.y);
   prediction->motion = Pose2D(chord.x(), chord.y(), angle);
   // First order: the chord turned by the correction, and moved by half of any error of the rotation.
-  Eigen::Matrix3d to_gyro = Eigen::Matrix3d::Zero();
-  to_gyro.topLeftCorner<2, 2>() << c, -s, s, c;
+  Eigen::Matrix3d turn = Eigen::Matrix3d::Zero();
+  turn.topLeftCorner<2, 2>() << c, -s, s, c;
   const Eigen::Vector3d chord_per_radian(-0.5 * chord.y(), 0.5 * chord.x(), 1.0);
-  const double angle_variance = gyroRotationVariance(gyro_.options(), angle, dt, gyro_bias_variance_);
+  const double angle_variance = gyroRotationVariance(imu_.options(), angle, dt, imu_bias_variance_);
   for (Eigen::Matrix3d* covariance : {&prediction->covariance, &prediction->nominal_covariance}) {
     const Eigen::Matrix2d translation = covariance->topLeftCorner<2, 2>();
     covariance->setZero();
     covariance->topLeftCorner<2, 2>() =
-        to_gyro.topLeftCorner<2, 2>() * translation * to_gyro.topLeftCorner<2, 2>().transpose();
+        turn.topLeftCorner<2, 2>() * translation * turn.topLeftCorner<2, 2>().transpose();
   }
   // The heading's noise is the IMU's alone (the wheels' heading noise is not learned from this step).
   prediction->covariance += angle_variance * chord_per_radian * chord_per_radian.transpose();
-  prediction->gyro = true;
+  prediction->rotation_from_imu = true;
 }
 
 MotionPrediction PoseExtrapolator::predictTranslation(double from, double to, const MotionNoiseModel& noise,
@@ -84,11 +79,12 @@ MotionPrediction PoseExtrapolator::predictTranslation(double from, double to, co
   Pose2D odom_from, odom_to;
   const double shift = odometry_time_offset_;
   double outside_from = 0.0, outside_to = 0.0;
-  if (use_odometry_ && odometry_.poseAt(from + shift, max_odometry_age_, &odom_from, &outside_from) &&
-      odometry_.poseAt(to + shift, max_odometry_age_, &odom_to, &outside_to)) {
+  const double max_age = options_.max_odometry_extrapolation;
+  if (options_.use_odometry && odometry_.poseAt(from + shift, max_age, &odom_from, &outside_from) &&
+      odometry_.poseAt(to + shift, max_age, &odom_to, &outside_to)) {
     const Pose2D motion = relativePose(odom_from, odom_to);
-    const bool plausible =
-        motion.translationNorm() <= max_speed_ * dt + kJitterMargin && plausibleTurn(motion.theta, dt);
+    const bool plausible = motion.translationNorm() <= options_.max_speed * dt + kJitterMargin &&
+                           plausibleTurn(motion.theta, dt);
     if (plausible) {
       prediction.source = PredictionSource::kOdometry;
       prediction.wheel_motion = motion;
@@ -128,8 +124,8 @@ double PoseExtrapolator::addPose(double stamp, const Pose2D& pose) {
   const Pose2D motion = relativePose(poses_.front().pose, pose);
   Eigen::Vector3d velocity(motion.x / baseline, motion.y / baseline, motion.theta / baseline);
   const double speed = velocity.head<2>().norm();
-  if (speed > max_speed_) velocity.head<2>() *= max_speed_ / speed;
-  velocity.z() = std::clamp(velocity.z(), -max_turn_rate_, max_turn_rate_);
+  if (speed > options_.max_speed) velocity.head<2>() *= options_.max_speed / speed;
+  velocity.z() = std::clamp(velocity.z(), -options_.max_turn_rate, options_.max_turn_rate);
   velocity_ = velocity;
   velocity_known_ = true;
   return baseline;

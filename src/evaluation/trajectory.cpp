@@ -57,17 +57,18 @@ bool writeTrackerTrace(const std::string& path, const std::vector<TrackerUpdate>
       "noise_theta guess_x guess_y guess_theta leap_probability vx vy wz time_offset scan_noise_weakest "
       "scan_noise_middle scan_noise_strongest degeneracy weakest_x weakest_y weakest_theta\n");
   for (const auto& u : updates) {
+    const TrackerDiagnostics& d = u.diagnostics;
     std::fprintf(file,
                  "%.6f %.4f %.4f %.5f %s %d %d %d %d %d %d %d %.3f %.3f %.3f %d %.2f %.3f %s %d %.3g %.3g "
                  "%.4f %.4f %.5f %.3g %.4f %.4f %.4f %.3f %.3g %.3g %.3g %.3g %.3f %.3f %.3f\n",
-                 u.stamp, u.pose.x, u.pose.y, u.pose.theta, toString(u.prediction), u.matched, u.fallback,
-                 u.prediction_doubted, u.leap, u.jump_rejected, u.new_keyframe, u.map_keyframes,
-                 u.search.box.half_x, u.search.box.half_y, u.search.box.half_theta, u.search.population,
-                 u.prior_mahalanobis, u.fitness_ratio, toString(u.match.status), u.match.iterations,
-                 u.noise_scale.xy, u.noise_scale.theta, u.guess.x, u.guess.y, u.guess.theta,
-                 u.leap_probability, u.velocity.x(), u.velocity.y(), u.velocity.z(), u.odometry_time_offset,
-                 u.scan_noise_scale[0], u.scan_noise_scale[1], u.scan_noise_scale[2], u.degeneracy,
-                 u.weakest_direction.x(), u.weakest_direction.y(), u.weakest_direction.z());
+                 u.stamp, u.pose.x, u.pose.y, u.pose.theta, toString(d.prediction), u.matched, u.fallback,
+                 d.prediction_doubted, u.leap, d.jump_rejected, u.new_keyframe, d.map_keyframes,
+                 d.search.box.half_x, d.search.box.half_y, d.search.box.half_theta, d.search.population,
+                 d.prior_mahalanobis, d.fitness_ratio, toString(d.match.status), d.match.iterations,
+                 d.learned.wheel_noise.xy, d.learned.wheel_noise.theta, d.guess.x, d.guess.y, d.guess.theta,
+                 d.leap_probability, u.velocity.x(), u.velocity.y(), u.velocity.z(), d.odometry_time_offset,
+                 d.learned.scan_noise[0], d.learned.scan_noise[1], d.learned.scan_noise[2], d.degeneracy,
+                 d.weakest_direction.x(), d.weakest_direction.y(), d.weakest_direction.z());
   }
   return std::fclose(file) == 0;
 }

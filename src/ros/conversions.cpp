@@ -37,37 +37,38 @@ visualization_msgs::Marker arrowMarker(const std_msgs::Header& header, int id, c
 
 /// Match's fields that say what happened to the scan and how it was searched.
 void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
-  match->prediction_source = toMsg(update.prediction);
-  match->rotation_from_imu = update.rotation_from_imu;
-  match->imu_bias = finiteFloat(update.imu_bias);
-  match->status = update.stale ? static_cast<uint8_t>(Match::STATUS_STALE) : toMsg(update.match.status);
-  match->status_text = update.stale ? "stale" : hglasm::toString(update.match.status);
-  match->jump_rejected = update.jump_rejected;
-  match->prediction_doubted = update.prediction_doubted;
+  const hglasm::TrackerDiagnostics& d = update.diagnostics;
+  match->prediction_source = toMsg(d.prediction);
+  match->rotation_from_imu = d.rotation_from_imu;
+  match->imu_bias = finiteFloat(d.learned.imu_bias);
+  match->status = update.stale ? static_cast<uint8_t>(Match::STATUS_STALE) : toMsg(d.match.status);
+  match->status_text = update.stale ? "stale" : hglasm::toString(d.match.status);
+  match->jump_rejected = d.jump_rejected;
+  match->prediction_doubted = d.prediction_doubted;
   match->leap = update.leap;
-  match->leap_probability = finiteFloat(update.leap_probability);
-  match->map_keyframes = nonNegative(update.map_keyframes);
-  match->search_box.x = update.search.box.half_x;
-  match->search_box.y = update.search.box.half_y;
-  match->search_box.theta = update.search.box.half_theta;
-  match->search_population = nonNegative(update.search.population);
-  match->prior_mahalanobis = finiteFloat(update.prior_mahalanobis);
-  match->noise_scale_xy = finiteFloat(update.noise_scale.xy);
-  match->noise_scale_theta = finiteFloat(update.noise_scale.theta);
-  match->degeneracy = finiteFloat(update.degeneracy);
-  match->weakest_direction.x = finiteFloat(update.weakest_direction.x());
-  match->weakest_direction.y = finiteFloat(update.weakest_direction.y());
-  match->weakest_direction.theta = finiteFloat(update.weakest_direction.z());
-  for (int j = 0; j < 3; ++j) match->scan_noise_scale[j] = finiteFloat(update.scan_noise_scale[j]);
-  match->deskewed = update.deskewed;
-  match->mbicp_status = toMsg(update.match.mbicp_status);
+  match->leap_probability = finiteFloat(d.leap_probability);
+  match->map_keyframes = nonNegative(d.map_keyframes);
+  match->search_box.x = d.search.box.half_x;
+  match->search_box.y = d.search.box.half_y;
+  match->search_box.theta = d.search.box.half_theta;
+  match->search_population = nonNegative(d.search.population);
+  match->prior_mahalanobis = finiteFloat(d.prior_mahalanobis);
+  match->noise_scale_xy = finiteFloat(d.learned.wheel_noise.xy);
+  match->noise_scale_theta = finiteFloat(d.learned.wheel_noise.theta);
+  match->degeneracy = finiteFloat(d.degeneracy);
+  match->weakest_direction.x = finiteFloat(d.weakest_direction.x());
+  match->weakest_direction.y = finiteFloat(d.weakest_direction.y());
+  match->weakest_direction.theta = finiteFloat(d.weakest_direction.z());
+  for (int j = 0; j < 3; ++j) match->scan_noise_scale[j] = finiteFloat(d.learned.scan_noise[j]);
+  match->deskewed = d.deskewed;
+  match->mbicp_status = toMsg(d.match.mbicp_status);
   match->matched = update.matched;
   match->fallback = update.fallback;
   match->new_keyframe = update.new_keyframe;
   match->reset = update.reset;
-  match->reanchored = update.reanchored;
-  match->odometry_time_offset = finiteFloat(update.odometry_time_offset);
-  match->odometry_time_offset_estimate = finiteFloat(update.odometry_time_offset_estimate);
+  match->reanchored = d.reanchored;
+  match->odometry_time_offset = finiteFloat(d.odometry_time_offset);
+  match->odometry_time_offset_estimate = finiteFloat(d.odometry_time_offset_estimate);
   match->keyframe_id = nonNegative(update.keyframe_id);
 }
 
@@ -364,27 +365,28 @@ nav_msgs::Odometry odometryMsgFromUpdate(const hglasm::TrackerUpdate& update, co
 Match matchMsgFromUpdate(const hglasm::PipelineUpdate& result, const std_msgs::Header& scan_header,
                          double total_ms, std::uint32_t dropped_scans) {
   const hglasm::TrackerUpdate& update = result.tracker;
+  const hglasm::MatchResult& matched = update.diagnostics.match;
   Match match;
   match.header.stamp = scan_header.stamp;
   match.header.frame_id = stripLeadingSlash(scan_header.frame_id);
   setMatchState(update, &match);
   if (update.matched) {
     if (result.laser_guess) match.guess_pose = pose2DMsgFromPose2D(*result.laser_guess);
-    match.prealigned_pose = pose2DMsgFromPose2D(update.match.prealigned_pose);
-    match.final_pose = pose2DMsgFromPose2D(update.match.pose);
+    match.prealigned_pose = pose2DMsgFromPose2D(matched.prealigned_pose);
+    match.final_pose = pose2DMsgFromPose2D(matched.pose);
   }
-  match.fitness_ratio = finiteFloat(update.fitness_ratio);
-  match.prealigned_fitness = update.match.prealigned_fitness;
-  match.prealigned_fitness_ratio = finiteFloat(update.match.prealigned_fitness_ratio);
-  match.evaluations = nonNegative(update.match.evaluations);
-  match.iterations = nonNegative(update.match.iterations);
-  match.associations = nonNegative(update.match.associations);
-  match.rms_error = finiteFloat(update.match.rms_error);
+  match.fitness_ratio = finiteFloat(update.diagnostics.fitness_ratio);
+  match.prealigned_fitness = matched.prealigned_fitness;
+  match.prealigned_fitness_ratio = finiteFloat(matched.prealigned_fitness_ratio);
+  match.evaluations = nonNegative(matched.evaluations);
+  match.iterations = nonNegative(matched.iterations);
+  match.associations = nonNegative(matched.associations);
+  match.rms_error = finiteFloat(matched.rms_error);
   match.valid_points = static_cast<std::uint32_t>(result.scan.size());
   match.invalid_points = nonNegative(result.scan.invalid_count);
-  match.table_build_ms = finiteFloat(update.table_build_ms);
-  match.prealign_ms = finiteFloat(update.match.prealign_ms);
-  match.refine_ms = finiteFloat(update.match.refine_ms);
+  match.table_build_ms = finiteFloat(update.diagnostics.table_build_ms);
+  match.prealign_ms = finiteFloat(matched.prealign_ms);
+  match.refine_ms = finiteFloat(matched.refine_ms);
   match.total_ms = finiteFloat(total_ms);
   match.dropped_scans = dropped_scans;
   return match;

@@ -74,11 +74,11 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
 
   scan_sub_ = nh_.subscribe("scan", kScanSubscriberQueue, &LaserOdometry::scanCallback, this,
                             ros::TransportHints().tcpNoDelay());
-  if (options_.tracker.use_odometry) {
+  if (options_.tracker.prediction.use_odometry) {
     odom_sub_ = nh_.subscribe("odom", kOdomSubscriberQueue, &LaserOdometry::odomCallback, this,
                               ros::TransportHints().tcpNoDelay());
   }
-  if (options_.tracker.use_imu) {
+  if (options_.tracker.prediction.use_imu) {
     imu_sub_ = nh_.subscribe("imu", kImuSubscriberQueue, &LaserOdometry::imuCallback, this,
                              ros::TransportHints().tcpNoDelay());
   }
@@ -88,9 +88,9 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
     ROS_INFO_STREAM("[" << name_ << "] taking poses to continue from on " << set_pose_sub_.getTopic());
   }
   ROS_INFO_STREAM("[" << name_ << "] laser odometry on " << scan_sub_.getTopic()
-                      << (options_.tracker.use_odometry ? " + " + odom_sub_.getTopic()
-                                                        : std::string(" (no wheel odometry)"))
-                      << (options_.tracker.use_imu ? " + " + imu_topic_ : std::string()) << ": "
+                      << (options_.tracker.prediction.use_odometry ? " + " + odom_sub_.getTopic()
+                                                                   : std::string(" (no wheel odometry)"))
+                      << (options_.tracker.prediction.use_imu ? " + " + imu_topic_ : std::string()) << ": "
                       << summarize(options_));
 }
 
@@ -159,7 +159,7 @@ bool LaserOdometry::imuValueInBase(const sensor_msgs::Imu& msg, double* value) {
   geometry_msgs::Quaternion mount;
   if (!imuMount(stripLeadingSlash(msg.header.frame_id), &mount)) return false;
   std::string error;
-  if (!imuValueFromMsg(msg, mount, options_.tracker.imu.use_orientation, value, &error)) {
+  if (!imuValueFromMsg(msg, mount, options_.tracker.prediction.imu.use_orientation, value, &error)) {
     warnThrottled("imu_bad", "IMU sample on " + imu_topic_ + " ignored: " + error, 10.0);
     return false;
   }
@@ -298,10 +298,11 @@ void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
   if (update.imu_stale) {
     std::ostringstream text;
     text << "no IMU data on " << imu_topic_ << " covers the step to the scan at " << update.tracker.stamp
-         << " s (missing, or a gap longer than imu/max_gap " << options_.tracker.imu.max_gap
+         << " s (missing, or a gap longer than imu/max_gap " << options_.tracker.prediction.imu.max_gap
          << " s); the rotation is predicted from "
-         << (update.tracker.prediction == hglasm::PredictionSource::kOdometry ? "the wheel odometry"
-             : update.tracker.prediction == hglasm::PredictionSource::kConstantVelocity
+         << (update.tracker.diagnostics.prediction == hglasm::PredictionSource::kOdometry
+                 ? "the wheel odometry"
+             : update.tracker.diagnostics.prediction == hglasm::PredictionSource::kConstantVelocity
                  ? "the recent motion"
                  : "nothing (no motion known yet)")
          << " until it returns";
@@ -469,13 +470,13 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
   record.fallback = update.fallback;
   std::lock_guard<std::mutex> lock(stats_mutex_);
   input_counts_ = pipeline_.inputCounts();
-  time_offset_ = update.odometry_time_offset;
-  time_offset_estimate_ = update.odometry_time_offset_estimate;
+  time_offset_ = update.diagnostics.odometry_time_offset;
+  time_offset_estimate_ = update.diagnostics.odometry_time_offset_estimate;
   if (update.matched) {
-    degeneracy_ = update.degeneracy;
-    weakest_direction_ = update.weakest_direction;
+    degeneracy_ = update.diagnostics.degeneracy;
+    weakest_direction_ = update.diagnostics.weakest_direction;
   }
-  noise_scale_ = update.noise_scale;
+  noise_scale_ = update.diagnostics.learned.wheel_noise;
   if (update.stale) return;  // not processed: not a scan of the rate or failure statistics
   ++scans_processed_;
   if (update.fallback) ++fallbacks_;
@@ -550,7 +551,7 @@ void LaserOdometry::publishPopulation(const ros::Time& stamp, const hglasm::Trac
   std_msgs::Header header;
   header.stamp = stamp;
   header.frame_id = options_.odom_frame;
-  population_pub_.publish(populationMarkers(header, population, update.pose, update.guess));
+  population_pub_.publish(populationMarkers(header, population, update.pose, update.diagnostics.guess));
 }
 
 void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -595,11 +596,12 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("dropped scans", dropped_total);
   status.add("stale scans dropped", input_counts_.stale_scans);
   status.add("stale odometry samples dropped", input_counts_.stale_odometry);
-  if (options_.tracker.use_imu) status.add("stale IMU samples dropped", input_counts_.stale_imu);
-  if (options_.tracker.use_odometry) {
+  if (options_.tracker.prediction.use_imu) status.add("stale IMU samples dropped", input_counts_.stale_imu);
+  if (options_.tracker.prediction.use_odometry) {
     status.add("odometry time offset (s)", time_offset_);
     status.add("odometry time offset, estimate (s)", time_offset_estimate_);
-    status.add("odometry time offset", options_.tracker.odometry_time_offset.estimate ? "learned" : "fixed");
+    status.add("odometry time offset",
+               options_.tracker.learning.odometry_time_offset.estimate ? "learned" : "fixed");
   }
   status.add("degeneracy of the last match (min / max information)", degeneracy_);
   status.add("weakest direction of the last match (x, y, theta)",
@@ -609,7 +611,7 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
              std::to_string(noise_scale_.xy) + ", " + std::to_string(noise_scale_.theta));
   status.add("queued scans", queued);
   status.add("preset", options_.preset);
-  if (options_.tracker.use_imu)
+  if (options_.tracker.prediction.use_imu)
     status.add("IMU", imu_stale_ ? "stale: rotation predicted without it" : "in use");
 
   const bool scans_arriving =
@@ -625,7 +627,7 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   } else if (matched > 0 && failure_ratio >= options_.diagnostics.warn_failure_ratio) {
     status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%.0f%% of scans failed to match",
                     100.0 * failure_ratio);
-  } else if (options_.tracker.use_imu && imu_stale_) {
+  } else if (options_.tracker.prediction.use_imu && imu_stale_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                    "IMU stale or missing: rotation predicted without it");
   } else if (dropped_total > last_reported_drops_) {

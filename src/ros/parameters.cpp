@@ -306,8 +306,8 @@ void visitNodeOptions(Params& tree, LaserOdometryOptions* options) {
   tree.frame("odom_frame", &options->odom_frame);
   tree.frame("base_frame", &options->base_frame);
   tree.boolean("publish_tf", &options->publish_tf);
-  tree.boolean("use_odom", &options->tracker.use_odometry);
-  tree.boolean("use_imu", &options->tracker.use_imu);
+  tree.boolean("use_odom", &options->tracker.prediction.use_odometry);
+  tree.boolean("use_imu", &options->tracker.prediction.use_imu);
   tree.integer("path_length", &options->path_length, 0, 1000000);
   tree.integer("queue_size", &options->queue_size, 1, 10000);
   tree.boolean("publish_population", &options->publish_population);
@@ -325,20 +325,20 @@ void visitTrackerOptions(Params& tree, hglasm::TrackerOptions* options) {
   tree.fraction("keyframe/min_fitness", &tracker.keyframe.min_fitness);
   tree.fraction("min_fitness", &tracker.min_fitness);
   tree.positiveInteger("min_points", &tracker.min_points);
-  tree.number("fallback_covariance_scale", &tracker.fallback_covariance_scale, 1.0, 1e12);
+  tree.number("fallback_covariance_scale", &tracker.uncertainty.fallback_scale, 1.0, 1e12);
   tree.positiveNumber("time/reset_on_jump_back", &tracker.reset_on_jump_back);
 
   // The search around the prediction, and leaps away from it.
   tree.boolean("fusion", &tracker.fusion);
-  tree.nonNegativeNumber("covariance/unexplained_xy", &tracker.unexplained_xy);
-  tree.nonNegativeNumber("covariance/unexplained_theta", &tracker.unexplained_theta);
-  tree.positiveNumber("search/sigmas", &tracker.search_sigmas);
-  tree.nonNegativeNumber("search/min_xy", &tracker.min_search_xy);
-  tree.number("search/min_theta", &tracker.min_search_theta, 0.0, M_PI);
-  tree.positiveNumber("leap/max_mahalanobis", &tracker.max_mahalanobis);
-  tree.number("leap/probability", &tracker.leap_probability, 0.0, 0.5, true);
-  tree.number("leap/persistence", &tracker.leap_persistence, 0.0, 1.0, true);
-  tree.number("leap/likelihood_outlier", &tracker.likelihood_outlier, 0.0, 1.0, true);
+  tree.nonNegativeNumber("covariance/unexplained_xy", &tracker.uncertainty.unexplained_xy);
+  tree.nonNegativeNumber("covariance/unexplained_theta", &tracker.uncertainty.unexplained_theta);
+  tree.positiveNumber("search/sigmas", &tracker.search.sigmas);
+  tree.nonNegativeNumber("search/min_xy", &tracker.search.min_xy);
+  tree.number("search/min_theta", &tracker.search.min_theta, 0.0, M_PI);
+  tree.positiveNumber("leap/max_mahalanobis", &tracker.leap.max_mahalanobis);
+  tree.number("leap/probability", &tracker.leap.probability, 0.0, 0.5, true);
+  tree.number("leap/persistence", &tracker.leap.persistence, 0.0, 1.0, true);
+  tree.number("leap/likelihood_outlier", &tracker.leap.likelihood_outlier, 0.0, 1.0, true);
 
   // The local map the scans are matched against.
   tree.positiveInteger("local_map/keyframes", &tracker.local_map.keyframes);
@@ -351,9 +351,10 @@ void visitTrackerOptions(Params& tree, hglasm::TrackerOptions* options) {
 template <typename Params>
 void visitPredictionOptions(Params& tree, LaserOdometryOptions* options) {
   hglasm::TrackerOptions& tracker = options->tracker;
-  tree.nonNegativeNumber("odometry/max_extrapolation", &tracker.odometry_max_extrapolation);
-  tree.timeOffset("odometry/time_offset", &tracker.odometry_time_offset);
-  tree.number("odometry/max_time_offset", &tracker.odometry_time_offset.max_offset, 0.0, kMaxFixedTimeOffset);
+  tree.nonNegativeNumber("odometry/max_extrapolation", &tracker.prediction.max_odometry_extrapolation);
+  tree.timeOffset("odometry/time_offset", &tracker.learning.odometry_time_offset);
+  tree.number("odometry/max_time_offset", &tracker.learning.odometry_time_offset.max_offset, 0.0,
+              kMaxFixedTimeOffset);
   hglasm::MotionNoiseOptions& motion = tracker.motion;
   tree.nonNegativeNumber("odometry/noise/xy_per_metre", &motion.xy_per_metre);
   tree.nonNegativeNumber("odometry/noise/xy_per_radian", &motion.xy_per_radian);
@@ -362,13 +363,13 @@ void visitPredictionOptions(Params& tree, LaserOdometryOptions* options) {
   tree.nonNegativeNumber("odometry/noise/theta_per_radian", &motion.theta_per_radian);
   tree.nonNegativeNumber("odometry/noise/theta_per_second", &motion.theta_per_second);
   tree.nonNegativeNumber("odometry/noise/systematic", &motion.systematic);
-  hglasm::NoiseLearnerOptions& learning = tracker.noise_learning;
+  hglasm::NoiseLearnerOptions& learning = tracker.learning.noise;
   tree.boolean("odometry/noise/learn", &learning.learn_wheels);
   tree.positiveNumber("odometry/noise/learn_half_life", &learning.half_life);
   tree.positiveInteger("odometry/noise/learn_lags", &learning.lags);
   tree.positiveNumber("odometry/noise/min_scale", &learning.min_wheel_scale);
   tree.positiveNumber("odometry/noise/max_scale", &learning.max_wheel_scale);
-  hglasm::WheelCalibrationOptions& calibration = tracker.wheel_calibration;
+  hglasm::WheelCalibrationOptions& calibration = tracker.learning.wheel_calibration;
   tree.boolean("odometry/calibration/learn", &calibration.learn);
   tree.positiveNumber("odometry/calibration/half_life", &calibration.half_life);
   tree.positiveNumber("odometry/calibration/heading_per_metre", &calibration.heading_per_metre);
@@ -382,10 +383,10 @@ void visitPredictionOptions(Params& tree, LaserOdometryOptions* options) {
   tree.positiveNumber("constant_velocity/theta", &motion.constant_velocity_theta);
   tree.nonNegativeNumber("constant_velocity/velocity_xy", &motion.constant_velocity_velocity_xy);
   tree.nonNegativeNumber("constant_velocity/velocity_theta", &motion.constant_velocity_velocity_theta);
-  tree.positiveNumber("odometry/max_speed", &tracker.max_odometry_speed);
-  tree.positiveNumber("odometry/max_turn_rate", &tracker.max_odometry_turn_rate);
+  tree.positiveNumber("odometry/max_speed", &tracker.prediction.max_speed);
+  tree.positiveNumber("odometry/max_turn_rate", &tracker.prediction.max_turn_rate);
   tree.number("odometry/wait", &options->odometry_wait, 0.0, 10.0);
-  hglasm::GyroOptions& imu = tracker.imu;
+  hglasm::GyroOptions& imu = tracker.prediction.imu;
   tree.boolean("imu/use_orientation", &imu.use_orientation);
   tree.number("imu/max_gap", &imu.max_gap, 0.0, 10.0, true);
   tree.nonNegativeNumber("imu/noise/angle_random_walk", &imu.angle_random_walk);
@@ -507,7 +508,7 @@ bool checkConsistency(const LaserOdometryOptions& options, std::string* error) {
     return fail("parameter ~genetic/tournament_size must not exceed ~genetic/population (" +
                 std::to_string(genetic.population) + "), got " + std::to_string(genetic.tournament_size));
   }
-  const hglasm::NoiseLearnerOptions& learning = options.tracker.noise_learning;
+  const hglasm::NoiseLearnerOptions& learning = options.tracker.learning.noise;
   if (learning.max_wheel_scale < learning.min_wheel_scale) {
     return fail("parameter ~odometry/noise/max_scale must be at least ~odometry/noise/min_scale (" +
                 formatNumber(learning.min_wheel_scale) + "), got " + formatNumber(learning.max_wheel_scale));
@@ -659,9 +660,9 @@ std::string summarize(const LaserOdometryOptions& options) {
       << matcher.table.cell_size << " m, keyframe " << options.tracker.keyframe.distance << " m / "
       << options.tracker.keyframe.angle << " rad, " << options.odom_frame << " -> " << options.base_frame
       << (options.publish_tf ? " (tf)" : " (no tf)")
-      << (options.tracker.use_odometry ? ", wheel odometry in" : ", no wheel odometry")
-      << (options.tracker.use_imu
-              ? (options.tracker.imu.use_orientation ? ", IMU orientation in" : ", IMU rate in")
+      << (options.tracker.prediction.use_odometry ? ", wheel odometry in" : ", no wheel odometry")
+      << (options.tracker.prediction.use_imu
+              ? (options.tracker.prediction.imu.use_orientation ? ", IMU orientation in" : ", IMU rate in")
               : "")
       << ", queue " << options.queue_size;
   return out.str();

@@ -18,7 +18,7 @@ class Replay {
       : data_(data), pipeline_(pipeline), options_(options), on_scan_(on_scan) {}
 
   ReplayCounts run() {
-    const bool use_odometry = pipeline_->options().use_odometry;
+    const bool use_odometry = pipeline_->options().prediction.use_odometry;
     for (const BagArrival& arrival : data_.arrivals) {
       const double now =
           arrival.scan ? data_.scans[arrival.index].receive_time : data_.odometry[arrival.index].receive_time;

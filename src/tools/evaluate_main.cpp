@@ -56,12 +56,12 @@ int evaluate(const EvaluateArguments& args) {
   if (!config_found) std::printf("config        %s not found: built-in defaults\n", args.config.c_str());
   for (const auto& warning : warnings) std::printf("config        warning: %s\n", warning.c_str());
   hglasm::TrackerOptions options = nodelet.tracker;
-  if (!args.use_odometry) options.use_odometry = false;
+  if (!args.use_odometry) options.prediction.use_odometry = false;
 
   EvaluateInputs inputs;
   if (!readEvaluateInputs(args, nodelet.base_frame, &inputs, &error)) return fail(error, 1);
   const BagData& data = inputs.data;
-  printInputs(stdout, args, inputs, nodelet.preset, options.use_odometry);
+  printInputs(stdout, args, inputs, nodelet.preset, options.prediction.use_odometry);
   const EvaluationRun run = runEvaluation(data, nodelet, options, args.min_scan_interval);
   printRun(stdout, run, data.scans.back().stamp - data.scans.front().stamp, !args.quiet);
 

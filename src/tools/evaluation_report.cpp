@@ -66,22 +66,23 @@ void printFusion(std::FILE* out, const EvaluationRun& run) {
   double map_keyframes = 0.0;
   const int small_population = hglasm::presetOptions(hglasm::Preset::kSmall).genetic.population;
   for (const auto& update : run.updates) {
-    rejected += update.jump_rejected;
-    doubted += update.prediction_doubted;
+    rejected += update.diagnostics.jump_rejected;
+    doubted += update.diagnostics.prediction_doubted;
     leaps += update.leap;
     if (update.matched) {
-      small_searches += update.search.population <= small_population;
-      map_keyframes += update.map_keyframes;
+      small_searches += update.diagnostics.search.population <= small_population;
+      map_keyframes += update.diagnostics.map_keyframes;
     }
   }
-  const hglasm::TrackerUpdate last = run.updates.empty() ? hglasm::TrackerUpdate() : run.updates.back();
+  const hglasm::LearnedModels last =
+      run.updates.empty() ? hglasm::LearnedModels() : run.updates.back().diagnostics.learned;
   std::fprintf(out,
                "\nfusion        prediction doubted %d times: %d leaps taken, %d rejected; %d of %d searches "
                "small-sized, %.1f keyframes per map; wheel noise scale learned: xy %.3g, theta %.3g; scan "
                "noise scale (weakest, middle, strongest direction) %.3g, %.3g, %.3g",
                doubted, leaps, rejected, small_searches, run.matched,
-               run.matched ? map_keyframes / run.matched : 0.0, last.noise_scale.xy, last.noise_scale.theta,
-               last.scan_noise_scale[0], last.scan_noise_scale[1], last.scan_noise_scale[2]);
+               run.matched ? map_keyframes / run.matched : 0.0, last.wheel_noise.xy, last.wheel_noise.theta,
+               last.scan_noise[0], last.scan_noise[1], last.scan_noise[2]);
   std::fprintf(
       out,
       "\nwheels        systematic errors learned: turn scale %+.4f, heading %+.3f deg/m, distance scale "

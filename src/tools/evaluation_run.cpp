@@ -26,6 +26,7 @@ std::string beamTimesOf(const hglasm::RangeScan& ranges, const hglasm::Scan& sca
 void record(const ReplayedScan& replayed, std::size_t warnings_kept, EvaluationRun* run) {
   const hglasm::PipelineUpdate& result = replayed.update;
   const hglasm::TrackerUpdate& update = result.tracker;
+  const hglasm::TrackerDiagnostics& diagnostics = update.diagnostics;
   ++run->processed;
   run->stale += update.stale;
   run->total_ms.push_back(replayed.cpu_ms);
@@ -33,15 +34,15 @@ void record(const ReplayedScan& replayed, std::size_t warnings_kept, EvaluationR
   if (result.scan_error != hglasm::ScanError::kNone) ++run->conversion_errors;
   if (update.matched) {
     ++run->matched;
-    run->prealign_ms.push_back(update.match.prealign_ms);
-    run->refine_ms.push_back(update.match.refine_ms);
-    ++run->statuses[hglasm::toString(update.match.status)];
+    run->prealign_ms.push_back(diagnostics.match.prealign_ms);
+    run->refine_ms.push_back(diagnostics.match.refine_ms);
+    ++run->statuses[hglasm::toString(diagnostics.match.status)];
   }
-  if (update.new_keyframe) run->table_ms.push_back(update.table_build_ms);
-  if (!update.stale) ++run->predictions[hglasm::toString(update.prediction)];
+  if (update.new_keyframe) run->table_ms.push_back(diagnostics.table_build_ms);
+  if (!update.stale) ++run->predictions[hglasm::toString(diagnostics.prediction)];
   run->fallbacks += update.fallback;
-  run->deskewed += update.deskewed;
-  run->reanchored += update.reanchored;
+  run->deskewed += diagnostics.deskewed;
+  run->reanchored += diagnostics.reanchored;
   if (run->beam_times.empty()) run->beam_times = beamTimesOf(replayed.scan->ranges, result.scan);
   run->keyframes += update.new_keyframe;
   run->resets += update.reset && run->processed > 1;  // the first scan starts, it does not reset

@@ -72,6 +72,48 @@ TEST(KeyframePolicy, KeyframeAddedMovesTheReference) {
   policy.keyframeAdded(far);
   EXPECT_FALSE(movedEnough(policy, far));
   EXPECT_TRUE(movedEnough(policy, Pose2D(0.0, 0.0, 0.0)));
+  EXPECT_EQ(policy.keyframes(), 2) << "policyAt() added the first";
+}
+
+/// A scan at `pose`, usable, matched, fitting well.
+hglasm::KeyframeCandidate scanAt(const Pose2D& pose) {
+  hglasm::KeyframeCandidate scan;
+  scan.pose = pose;
+  scan.usable = true;
+  scan.matched = true;
+  scan.fitness_ratio = 0.9;
+  return scan;
+}
+
+TEST(KeyframePolicy, DecideAddsWhatWantsKeyframeWantsAndFillsAnEmptyMap) {
+  using hglasm::KeyframeAction;
+  KeyframePolicy policy = policyAt(Pose2D());
+  EXPECT_EQ(policy.decide(scanAt(Pose2D(0.1, 0.0, 0.0)), false), KeyframeAction::kNone);
+  EXPECT_EQ(policy.decide(scanAt(Pose2D(0.6, 0.0, 0.0)), false), KeyframeAction::kAdd);
+  EXPECT_EQ(policy.decide(scanAt(Pose2D(0.1, 0.0, 0.0)), true), KeyframeAction::kAdd) << "an empty map";
+  hglasm::KeyframeCandidate unusable = scanAt(Pose2D(0.6, 0.0, 0.0));
+  unusable.usable = false;
+  EXPECT_EQ(policy.decide(unusable, true), KeyframeAction::kNone) << "no points to hold";
+  hglasm::KeyframeCandidate leapt = scanAt(Pose2D(0.6, 0.0, 0.0));
+  leapt.leapt = true;
+  EXPECT_EQ(policy.decide(leapt, false), KeyframeAction::kNone)
+      << "a keyframe would hold the map to the leap";
+}
+
+TEST(KeyframePolicy, OneUnexplainedScanStaysOutTheSecondRestartsTheMap) {
+  using hglasm::KeyframeAction;
+  KeyframePolicy policy = policyAt(Pose2D());
+  hglasm::KeyframeCandidate unexplained = scanAt(Pose2D(0.05, 0.0, 0.0));
+  unexplained.match_failed = true;
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone) << "someone in front of the laser";
+  EXPECT_EQ(policy.decide(scanAt(Pose2D(0.05, 0.0, 0.0)), false), KeyframeAction::kNone) << "the map holds";
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone) << "one in a row again";
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kRestartMap) << "two in a row";
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone) << "the count starts afresh";
+  policy.restart();
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone) << "a restart forgets the first";
+  EXPECT_EQ(policy.decide(unexplained, true), KeyframeAction::kAdd) << "an empty map explains nothing";
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone) << "and counts afresh";
 }
 
 }  // namespace

@@ -198,3 +198,48 @@ TEST(LocalMap, AtLeastOneKeyframe) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(LocalMap, ItsFrameMovesOnlyEveryReframeDistanceAndOtherwiseKeyframesOnlyAddPoints) {
+  LocalMapOptions options;
+  options.keyframes = 20;
+  options.resolution = 0.0;
+  options.reframe_distance = 1.0;
+  LocalMap map(options);
+  LocalMap rebuilt([&] {  // the same map re-expressed at every keyframe
+    LocalMapOptions every = options;
+    every.reframe_distance = 0.0;
+    return every;
+  }());
+  int reframes = 0;
+  for (int k = 0; k < 12; ++k) {
+    const Pose2D pose(0.3 * k, 0.05 * k, 0.02 * k);  // 0.3 m apart
+    const Pose2D frame_before = map.frame();
+    map.add(pose, wall(2.0, 0.5, 0.05));
+    rebuilt.add(pose, wall(2.0, 0.5, 0.05));
+    EXPECT_EQ(rebuilt.unchangedScans(), 0u);
+    const bool moved = map.unchangedScans() == 0;
+    reframes += moved;
+    if (moved) {
+      EXPECT_NEAR((map.frame().translation() - pose.translation()).norm(), 0.0, 1e-12) << "keyframe " << k;
+    } else {
+      EXPECT_EQ(map.frame().x, frame_before.x);
+      EXPECT_EQ(map.unchangedScans() + 1, map.reference().scan_starts.size()) << "one scan added";
+      EXPECT_LT((frame_before.translation() - pose.translation()).norm(), options.reframe_distance);
+    }
+    // Whichever frame it is in, the reference is the same points in the odometry frame.
+    ASSERT_EQ(map.reference().size(), rebuilt.reference().size());
+    for (std::size_t i = 0; i < map.reference().size(); ++i) {
+      const Eigen::Vector2d a = map.frame() * map.reference().points[i];
+      const Eigen::Vector2d b = rebuilt.frame() * rebuilt.reference().points[i];
+      EXPECT_NEAR((a - b).norm(), 0.0, 1e-9) << "keyframe " << k << ", point " << i;
+    }
+    EXPECT_EQ(map.reference().scan_steps.size(), map.reference().scan_starts.size());
+    EXPECT_NEAR(map.table(0).maxCellValue(), rebuilt.table(0).maxCellValue(), 0);
+  }
+  // 0.3 m per keyframe: the frame moves at the first keyframe and then every fourth (1.2 m >= 1 m).
+  EXPECT_EQ(reframes, 3);
+}
+
+}  // namespace

@@ -466,3 +466,36 @@ TEST(Mbicp, AnIsolatedFarPointDoesNotTurnTheScanByWhereInItsBeamItWasSampled) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Mbicp, ExtendingTheReferenceGivesWhatARebuildGives) {
+  // Three keyframes of a room in one frame: given at once, or the first two and then the third appended.
+  const hglasm_test::World world = hglasm_test::room();
+  const LaserSpec laser = hglasm_test::halfCircleLaser();
+  hglasm::ReferencePoints first_two, all;
+  const Pose2D poses[3] = {Pose2D(0.0, 0.0, 0.0), Pose2D(0.4, 0.1, 0.2), Pose2D(0.8, -0.1, -0.3)};
+  for (int k = 0; k < 3; ++k) {
+    const Scan scan = hglasm_test::simulateScan(world, poses[k], laser);
+    if (k < 2) first_two.append(scan.points, poses[k]);
+    all.append(scan.points, poses[k]);
+  }
+  Mbicp rebuilt, extended;
+  rebuilt.setReference(all);
+  extended.setReference(first_two);
+  extended.extendReference(all, 2);
+  const Scan scan = hglasm_test::simulateScan(world, Pose2D(0.5, 0.0, 0.1), laser);
+  for (const Pose2D& initial : {Pose2D(0.45, 0.03, 0.08), Pose2D(0.6, -0.05, 0.15)}) {
+    const MbicpResult a = rebuilt.match(scan, initial);
+    const MbicpResult b = extended.match(scan, initial);
+    EXPECT_EQ(a.pose.x, b.pose.x);
+    EXPECT_EQ(a.pose.y, b.pose.y);
+    EXPECT_EQ(a.pose.theta, b.pose.theta);
+    EXPECT_EQ(a.iterations, b.iterations);
+    EXPECT_EQ(a.associations, b.associations);
+    EXPECT_TRUE(a.covariance == b.covariance);
+    expectExact(a, Pose2D(0.5, 0.0, 0.1));
+  }
+}
+
+}  // namespace

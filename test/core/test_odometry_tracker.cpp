@@ -45,12 +45,12 @@ Path spinPath(double rate) {
 
 void expectSane(const TrackerUpdate& update) {
   EXPECT_TRUE(update.pose.isFinite()) << "stamp " << update.stamp;
-  EXPECT_TRUE(update.guess.isFinite()) << "stamp " << update.stamp;
+  EXPECT_TRUE(update.diagnostics.guess.isFinite()) << "stamp " << update.stamp;
   EXPECT_TRUE(update.velocity.allFinite()) << "stamp " << update.stamp;
   EXPECT_TRUE(hglasm_test::isValidCovariance(update.pose_covariance)) << update.pose_covariance;
   EXPECT_TRUE(hglasm_test::isValidCovariance(update.velocity_covariance)) << update.velocity_covariance;
-  EXPECT_TRUE(update.match.pose.isFinite());
-  EXPECT_TRUE(update.match.covariance.allFinite());
+  EXPECT_TRUE(update.diagnostics.match.pose.isFinite());
+  EXPECT_TRUE(update.diagnostics.match.covariance.allFinite());
 }
 
 /// Drives a simulated robot along `path` and feeds the tracker its scans (and optionally wheel odometry).
@@ -136,7 +136,7 @@ class SimulatedRobot {
 
 TrackerOptions withoutOdometry() {
   TrackerOptions options;
-  options.use_odometry = false;
+  options.prediction.use_odometry = false;
   return options;
 }
 
@@ -190,7 +190,7 @@ TEST(OdometryTracker, FollowsACircleWithoutWheelOdometry) {
   const Pose2D truth = robot.truth(25.0);
   EXPECT_EQ(fallbacks, 0);
   EXPECT_GT(keyframes, 10);
-  EXPECT_EQ(last.prediction, PredictionSource::kConstantVelocity);
+  EXPECT_EQ(last.diagnostics.prediction, PredictionSource::kConstantVelocity);
   hglasm_test::expectPoseNear(last.pose, truth, 0.05, hglasm_test::deg(0.5), "final pose");
   // The velocity is the path's: 0.5 m/s forward, turning right at 1/3 rad/s.
   EXPECT_NEAR(last.velocity.x(), 0.5, 0.05);
@@ -205,7 +205,7 @@ TEST(OdometryTracker, FollowsACircleWithDriftingWheelOdometry) {
   const TrackerUpdate last = drive(&robot, 25.0, &fallbacks, &keyframes);
   const Pose2D truth = robot.truth(25.0);
   EXPECT_EQ(fallbacks, 0);
-  EXPECT_EQ(last.prediction, PredictionSource::kOdometry);
+  EXPECT_EQ(last.diagnostics.prediction, PredictionSource::kOdometry);
   hglasm_test::expectPoseNear(last.pose, truth, 0.05, hglasm_test::deg(0.5), "final pose");
   // The wheel odometry alone is far off: the laser did the work.
   EXPECT_GT(hglasm_test::translationError(robot.odometryPose(), truth), 0.3);
@@ -226,8 +226,8 @@ TEST(OdometryTracker, EveryAlgorithmIsJudgedOnTheSameGradedTable) {
     EXPECT_EQ(fallbacks, 0);
     hglasm_test::expectPoseNear(last.pose, robot.truth(3.0), 0.03, hglasm_test::deg(0.5), "final pose");
     // A simulated scan on its own map at the right pose: nearly every point on a surface.
-    EXPECT_GT(last.fitness_ratio, 0.8);
-    EXPECT_LE(last.fitness_ratio, 1.0);
+    EXPECT_GT(last.diagnostics.fitness_ratio, 0.8);
+    EXPECT_LE(last.diagnostics.fitness_ratio, 1.0);
   }
 }
 
@@ -240,8 +240,8 @@ TEST(OdometryTracker, AFailedMatchPublishesTheFitnessAtThePredictedPose) {
   const TrackerUpdate update = robot.step(0.1);
   EXPECT_TRUE(update.matched);
   EXPECT_TRUE(update.fallback);
-  EXPECT_GT(update.fitness_ratio, 0.8);
-  EXPECT_LT(update.fitness_ratio, 1.0);
+  EXPECT_GT(update.diagnostics.fitness_ratio, 0.8);
+  EXPECT_LT(update.diagnostics.fitness_ratio, 1.0);
 }
 
 TEST(OdometryTracker, LaserMountIsAccountedFor) {
@@ -273,7 +273,7 @@ TEST(OdometryTracker, DeskewUndoesTheShearOfASweepTakenWhileMoving) {
       const TrackerUpdate update = robot.step(0.1 * i);
       expectSane(update);
       if (update.fallback) ++fallbacks;
-      if (update.deskewed) ++*deskewed;
+      if (update.diagnostics.deskewed) ++*deskewed;
       if (i == 60) at_six_seconds = update.pose;
       last = update.pose;
     }
@@ -368,7 +368,7 @@ TEST(OdometryTracker, AForwardGapContinuesFromThePose) {
   expectSane(gap);
   EXPECT_FALSE(gap.reset);
   EXPECT_FALSE(gap.fallback);
-  EXPECT_EQ(gap.prediction, hglasm::PredictionSource::kOdometry);
+  EXPECT_EQ(gap.diagnostics.prediction, hglasm::PredictionSource::kOdometry);
   EXPECT_NEAR(gap.pose.x, stop_and_go(600.6).x, 0.01);
   const TrackerUpdate next = robot.step(0.7 + 600.0);
   expectSane(next);
@@ -411,7 +411,7 @@ TEST(OdometryTracker, EmptyScansFallBackToTheOdometryGuess) {
     expectSane(update);
     EXPECT_TRUE(update.published) << i;
     EXPECT_TRUE(update.fallback) << i;
-    EXPECT_EQ(update.prediction, PredictionSource::kOdometry);
+    EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kOdometry);
     const Pose2D truth = robot.truth(0.1 * i);
     EXPECT_LT(hglasm_test::translationError(update.pose, truth), 0.01) << i;
     EXPECT_LT(hglasm_test::rotationError(update.pose, truth), hglasm_test::deg(0.2)) << i;
@@ -436,7 +436,7 @@ TEST(OdometryTracker, EmptyScansWithoutOdometryKeepTheConstantVelocity) {
     update = robot.step(0.1 * i, &empty);
     expectSane(update);
     EXPECT_TRUE(update.fallback) << i;
-    EXPECT_EQ(update.prediction, PredictionSource::kConstantVelocity);
+    EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kConstantVelocity);
   }
   EXPECT_NEAR(update.pose.x, 0.4 * 1.4, 0.01);  // kept moving at 0.4 m/s
   EXPECT_NEAR(update.pose.y, 0.0, 0.01);
@@ -602,8 +602,8 @@ FastTurnRun runFastTurns(bool use_imu, double turn_rate, double scan_rate, doubl
                          double noise_density, const hglasm::GyroOptions& gyro = {},
                          double sweep_fraction = 0.0) {
   TrackerOptions options;
-  options.use_imu = use_imu;
-  options.imu = gyro;
+  options.prediction.use_imu = use_imu;
+  options.prediction.imu = gyro;
   const Path path = hglasm_test::squareWithSpins(turn_rate);
   SimulatedRobot robot(options, path);
   robot.enableOdometry(0.0, 0.0, turn_scale);
@@ -618,12 +618,12 @@ FastTurnRun runFastTurns(bool use_imu, double turn_rate, double scan_rate, doubl
     expectSane(update);
     run.fallbacks += update.fallback;
     run.leaps += update.leap;
-    run.rotations_from_imu += update.rotation_from_imu;
+    run.rotations_from_imu += update.diagnostics.rotation_from_imu;
     run.scans += i > 0;
     run.worst_rotation_error =
         std::max(run.worst_rotation_error, hglasm_test::rotationError(update.pose, robot.truth(t)));
   }
-  run.learned_bias = update.imu_bias;
+  run.learned_bias = update.diagnostics.learned.imu_bias;
   run.translation_error = hglasm_test::translationError(update.pose, robot.truth(update.stamp));
   run.rotation_error = hglasm_test::rotationError(update.pose, robot.truth(update.stamp));
   return run;
@@ -727,21 +727,21 @@ TEST(OdometryTracker, WithASweepingLaserTheGyroDeskewsTheSpins) {
 
 TEST(OdometryTracker, WhenTheGyroStopsTheWheelsPredictTheRotation) {
   TrackerOptions options;
-  options.use_imu = true;
+  options.prediction.use_imu = true;
   SimulatedRobot robot(options, circlePath);
   robot.enableOdometry(0.0, 0.0);
   robot.enableGyro(kGyroBias, kGyroNoiseDensity, 3);
   TrackerUpdate update;
   for (int i = 0; i <= 20; ++i) update = robot.step(0.1 * i);
-  EXPECT_TRUE(update.rotation_from_imu);
+  EXPECT_TRUE(update.diagnostics.rotation_from_imu);
   robot.disableGyro();
   for (int i = 21; i <= 40; ++i) {
     update = robot.step(0.1 * i);
     expectSane(update);
     if (i >= 23) {
-      EXPECT_FALSE(update.rotation_from_imu) << "scan " << i << ": the gyro stopped at 2.0 s";
+      EXPECT_FALSE(update.diagnostics.rotation_from_imu) << "scan " << i << ": the gyro stopped at 2.0 s";
     }
-    EXPECT_EQ(update.prediction, PredictionSource::kOdometry);
+    EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kOdometry);
   }
   hglasm_test::expectPoseNear(update.pose, robot.truth(4.0), 0.02, hglasm_test::deg(0.5), "final pose");
 }

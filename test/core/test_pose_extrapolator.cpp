@@ -22,8 +22,17 @@ constexpr double kMaxSpeed = 2.0;     // m/s
 constexpr double kMaxTurnRate = 1.0;  // rad/s
 constexpr double kOdometryAge = 0.5;  // s
 
+hglasm::PoseExtrapolatorOptions extrapolatorOptions(bool use_odometry) {
+  hglasm::PoseExtrapolatorOptions options;
+  options.use_odometry = use_odometry;
+  options.max_odometry_extrapolation = kOdometryAge;
+  options.max_speed = kMaxSpeed;
+  options.max_turn_rate = kMaxTurnRate;
+  return options;
+}
+
 PoseExtrapolator makeExtrapolator(bool use_odometry = true) {
-  return PoseExtrapolator(use_odometry, kOdometryAge, kMaxSpeed, kMaxTurnRate);
+  return PoseExtrapolator(extrapolatorOptions(use_odometry));
 }
 
 void expectPose(const Pose2D& actual, double x, double y, double theta, double tolerance = 1e-12) {
@@ -134,7 +143,10 @@ TEST(PoseExtrapolator, WithoutWheelsALongPauseKeepsThePose) {
   // its noise is that of kMaxVelocityAge (the search is the preset's box).
   const MotionNoiseModel noise;
   std::string warning;
-  PoseExtrapolator extrapolator(false, 0.5, 5.0, 6.0);
+  hglasm::PoseExtrapolatorOptions options;
+  options.use_odometry = false;
+  options.max_odometry_extrapolation = 0.5;
+  PoseExtrapolator extrapolator(options);
   extrapolator.addPose(0.0, Pose2D());
   extrapolator.addPose(0.5, Pose2D(0.5, 0.0, 0.0));
   ASSERT_TRUE(extrapolator.velocityKnown());
@@ -147,26 +159,27 @@ TEST(PoseExtrapolator, WithoutWheelsALongPauseKeepsThePose) {
   EXPECT_EQ(pause.covariance, noise.constantVelocityCovariance(PoseExtrapolator::kMaxVelocityAge));
 }
 
-PoseExtrapolator makeGyroExtrapolator(bool use_odometry = true) {
-  hglasm::GyroOptions gyro;
-  gyro.angle_random_walk = 0.01;
-  gyro.bias_sigma = 0.02;
-  gyro.scale_error = 0.03;
-  return PoseExtrapolator(use_odometry, kOdometryAge, kMaxSpeed, kMaxTurnRate, true, gyro);
+PoseExtrapolator makeImuExtrapolator(bool use_odometry = true) {
+  hglasm::PoseExtrapolatorOptions options = extrapolatorOptions(use_odometry);
+  options.use_imu = true;
+  options.imu.angle_random_walk = 0.01;
+  options.imu.bias_sigma = 0.02;
+  options.imu.scale_error = 0.03;
+  return PoseExtrapolator(options);
 }
 
 TEST(PoseExtrapolator, TheGyroGivesTheRotationAndTurnsTheWheelsChordWithIt) {
-  PoseExtrapolator extrapolator = makeGyroExtrapolator();
+  PoseExtrapolator extrapolator = makeImuExtrapolator();
   // The wheels: 1 m straight ahead, no turn. The gyro: 0.8 rad/s for 0.5 s, 0.4 rad. The chord of the arc
   // turns by half the rotation: (cos 0.2, sin 0.2).
   extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
   extrapolator.addOdometry(0.5, Pose2D(1.0, 0.0, 0.0));
-  for (int i = 0; i <= 50; ++i) EXPECT_TRUE(extrapolator.addGyro(0.01 * i, 0.8));
+  for (int i = 0; i <= 50; ++i) EXPECT_TRUE(extrapolator.addImu(0.01 * i, 0.8));
   const MotionNoiseModel noise;
   std::string warning;
   const MotionPrediction prediction = extrapolator.predict(0.0, 0.5, noise, &warning);
   EXPECT_EQ(prediction.source, PredictionSource::kOdometry);
-  EXPECT_TRUE(prediction.gyro);
+  EXPECT_TRUE(prediction.rotation_from_imu);
   expectPose(prediction.motion, std::cos(0.2), std::sin(0.2), 0.4);
   // First order: the wheels' translation noise turned with the chord (theirs is isotropic here), and the
   // gyro's heading noise, which also moves the chord by half of it across the chord; the wheels' nominal
@@ -185,75 +198,76 @@ TEST(PoseExtrapolator, TheGyroGivesTheRotationAndTurnsTheWheelsChordWithIt) {
 TEST(PoseExtrapolator, TheChordIsTurnedTheShortWayForTurnsBeyondPiAndToTheRight) {
   // 3.3 rad in 4 s (the wheels' heading wraps to 3.3 - 2 pi, the gyro's does not): both agree, so the
   // chord, at half the rotation, stays where the wheels put it.
-  PoseExtrapolator extrapolator = makeGyroExtrapolator();
+  PoseExtrapolator extrapolator = makeImuExtrapolator();
   extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
   extrapolator.addOdometry(4.0, Pose2D(std::cos(1.65), std::sin(1.65), 3.3));
-  for (int i = 0; i <= 400; ++i) extrapolator.addGyro(0.01 * i, 3.3 / 4.0);
+  for (int i = 0; i <= 400; ++i) extrapolator.addImu(0.01 * i, 3.3 / 4.0);
   const MotionNoiseModel noise;
   std::string warning;
   const MotionPrediction wide = extrapolator.predict(0.0, 4.0, noise, &warning);
-  ASSERT_TRUE(wide.gyro) << warning;
+  ASSERT_TRUE(wide.rotation_from_imu) << warning;
   expectPose(wide.motion, std::cos(1.65), std::sin(1.65), 3.3, 1e-9);
 
   // To the right: the wheels turn -0.2 rad, the gyro -0.4: the chord turns by -0.1 more.
-  PoseExtrapolator right = makeGyroExtrapolator();
+  PoseExtrapolator right = makeImuExtrapolator();
   right.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
   right.addOdometry(0.5, Pose2D(std::cos(-0.1), std::sin(-0.1), -0.2));
-  for (int i = 0; i <= 50; ++i) right.addGyro(0.01 * i, -0.8);
+  for (int i = 0; i <= 50; ++i) right.addImu(0.01 * i, -0.8);
   const MotionPrediction turned = right.predict(0.0, 0.5, noise, &warning);
-  ASSERT_TRUE(turned.gyro);
+  ASSERT_TRUE(turned.rotation_from_imu);
   expectPose(turned.motion, std::cos(-0.2), std::sin(-0.2), -0.4, 1e-9);
 }
 
 TEST(PoseExtrapolator, AnImplausiblyFastGyroIsNotUsedAndSaysSo) {
-  PoseExtrapolator extrapolator = makeGyroExtrapolator();
+  PoseExtrapolator extrapolator = makeImuExtrapolator();
   extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
   extrapolator.addOdometry(0.5, Pose2D(1.0, 0.0, 0.1));
-  for (int i = 0; i <= 50; ++i) extrapolator.addGyro(0.01 * i, 20.0);  // 10 rad in 0.5 s: a spike
+  for (int i = 0; i <= 50; ++i) extrapolator.addImu(0.01 * i, 20.0);  // 10 rad in 0.5 s: a spike
   std::string warning;
   const MotionPrediction prediction = extrapolator.predict(0.0, 0.5, MotionNoiseModel(), &warning);
-  EXPECT_FALSE(prediction.gyro);
+  EXPECT_FALSE(prediction.rotation_from_imu);
   expectPose(prediction.motion, 1.0, 0.0, 0.1);
   EXPECT_NE(warning.find("IMU rotation"), std::string::npos) << warning;
 }
 
 TEST(PoseExtrapolator, WithoutWheelsTheGyroTurnsTheConstantVelocityPrediction) {
-  PoseExtrapolator extrapolator = makeGyroExtrapolator(false);
+  PoseExtrapolator extrapolator = makeImuExtrapolator(false);
   extrapolator.addPose(0.0, Pose2D(0.0, 0.0, 0.0));
   extrapolator.addPose(0.5, Pose2D(0.5, 0.0, 0.0));  // 1 m/s straight
-  for (int i = 0; i <= 100; ++i) extrapolator.addGyro(0.01 * i, -1.0);
+  for (int i = 0; i <= 100; ++i) extrapolator.addImu(0.01 * i, -1.0);
   std::string warning;
   const MotionPrediction prediction = extrapolator.predict(0.5, 0.7, MotionNoiseModel(), &warning);
   EXPECT_EQ(prediction.source, PredictionSource::kConstantVelocity);
-  EXPECT_TRUE(prediction.gyro);
+  EXPECT_TRUE(prediction.rotation_from_imu);
   expectPose(prediction.motion, 0.2 * std::cos(-0.1), 0.2 * std::sin(-0.1), -0.2);
 }
 
 TEST(PoseExtrapolator, StaleOrMissingGyroLeavesTheWheelsPrediction) {
-  PoseExtrapolator extrapolator = makeGyroExtrapolator();
+  PoseExtrapolator extrapolator = makeImuExtrapolator();
   extrapolator.addOdometry(0.0, Pose2D(0.0, 0.0, 0.0));
   extrapolator.addOdometry(1.0, Pose2D(1.0, 0.0, 0.3));
   const MotionNoiseModel noise;
   std::string warning;
   const MotionPrediction missing = extrapolator.predict(0.0, 1.0, noise, &warning);
-  EXPECT_FALSE(missing.gyro);
+  EXPECT_FALSE(missing.rotation_from_imu);
   expectPose(missing.motion, 1.0, 0.0, 0.3);
   EXPECT_EQ(missing.covariance, noise.odometryCovariance(missing.motion, 1.0));
-  for (int i = 0; i <= 50; ++i) extrapolator.addGyro(0.01 * i, 1.0);  // stops at 0.5 s
+  for (int i = 0; i <= 50; ++i) extrapolator.addImu(0.01 * i, 1.0);  // stops at 0.5 s
   const MotionPrediction stale = extrapolator.predict(0.0, 1.0, noise, &warning);
-  EXPECT_FALSE(stale.gyro);
+  EXPECT_FALSE(stale.rotation_from_imu);
   expectPose(stale.motion, 1.0, 0.0, 0.3);
-  EXPECT_TRUE(extrapolator.predict(0.0, 0.55, noise, &warning).gyro) << "within max_gap of the newest sample";
-  extrapolator.clearGyro();
-  EXPECT_FALSE(extrapolator.predict(0.0, 0.5, noise, &warning).gyro) << "cleared";
+  EXPECT_TRUE(extrapolator.predict(0.0, 0.55, noise, &warning).rotation_from_imu)
+      << "within max_gap of the newest sample";
+  extrapolator.clearImu();
+  EXPECT_FALSE(extrapolator.predict(0.0, 0.5, noise, &warning).rotation_from_imu) << "cleared";
 }
 
-TEST(PoseExtrapolator, GyroSamplesAreIgnoredWithoutUseGyro) {
+TEST(PoseExtrapolator, ImuSamplesAreIgnoredWithoutUseImu) {
   PoseExtrapolator extrapolator = makeExtrapolator();
-  EXPECT_FALSE(extrapolator.addGyro(0.0, 1.0));
-  EXPECT_FALSE(extrapolator.addGyro(0.1, 1.0));
+  EXPECT_FALSE(extrapolator.addImu(0.0, 1.0));
+  EXPECT_FALSE(extrapolator.addImu(0.1, 1.0));
   std::string warning;
-  EXPECT_FALSE(extrapolator.predict(0.0, 0.1, MotionNoiseModel(), &warning).gyro);
+  EXPECT_FALSE(extrapolator.predict(0.0, 0.1, MotionNoiseModel(), &warning).rotation_from_imu);
 }
 
 TEST(PoseExtrapolator, VelocityNeedsABaselineOfATenthOfASecond) {

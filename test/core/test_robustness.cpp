@@ -59,21 +59,22 @@ Path arcPath(double speed, double rate) {
 std::string describe(const TrackerUpdate& u) {
   std::ostringstream text;
   text << "stamp " << u.stamp << " pose " << u.pose.x << " " << u.pose.y << " " << u.pose.theta << " matched "
-       << u.matched << " fallback " << u.fallback << " status " << hglasm::toString(u.match.status)
-       << " fitness " << u.fitness_ratio << " prediction " << hglasm::toString(u.prediction) << " keyframe "
-       << u.new_keyframe << " reset " << u.reset << " warning '" << u.warning << "'";
+       << u.matched << " fallback " << u.fallback << " status "
+       << hglasm::toString(u.diagnostics.match.status) << " fitness " << u.diagnostics.fitness_ratio
+       << " prediction " << hglasm::toString(u.diagnostics.prediction) << " keyframe " << u.new_keyframe
+       << " reset " << u.reset << " warning '" << u.warning << "'";
   return text.str();
 }
 
 /// Never NaN, never an invalid covariance, whatever went in.
 void expectSane(const TrackerUpdate& u) {
   EXPECT_TRUE(u.pose.isFinite()) << describe(u);
-  EXPECT_TRUE(u.guess.isFinite()) << describe(u);
+  EXPECT_TRUE(u.diagnostics.guess.isFinite()) << describe(u);
   EXPECT_TRUE(u.velocity.allFinite()) << describe(u);
   EXPECT_TRUE(hglasm_test::isValidCovariance(u.pose_covariance)) << describe(u) << "\n" << u.pose_covariance;
   EXPECT_TRUE(hglasm_test::isValidCovariance(u.velocity_covariance)) << describe(u);
-  EXPECT_TRUE(u.match.pose.isFinite()) << describe(u);
-  EXPECT_TRUE(u.match.covariance.allFinite()) << describe(u);
+  EXPECT_TRUE(u.diagnostics.match.pose.isFinite()) << describe(u);
+  EXPECT_TRUE(u.diagnostics.match.covariance.allFinite()) << describe(u);
 }
 
 /// A simulated robot whose scans and wheel odometry (optional, 50 Hz, can be delayed or corrupted) go
@@ -154,7 +155,7 @@ class Robot {
 
 TrackerOptions withoutOdometry() {
   TrackerOptions options;
-  options.use_odometry = false;
+  options.prediction.use_odometry = false;
   return options;
 }
 
@@ -195,8 +196,8 @@ TEST(Robustness, UnusableScansAreFlaggedAndIntegrateTheOdometryGuess) {
       EXPECT_TRUE(update.published) << describe(update);
       EXPECT_TRUE(update.fallback) << describe(update);
       EXPECT_FALSE(update.new_keyframe) << describe(update);  // the keyframe is kept for when scans return
-      EXPECT_EQ(update.match.status, hglasm::MatchStatus::kTooFewPoints) << describe(update);
-      EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+      EXPECT_EQ(update.diagnostics.match.status, hglasm::MatchStatus::kTooFewPoints) << describe(update);
+      EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kOdometry) << describe(update);
       expectPoseNear(update.pose, robot.truth(0.1 * i), 0.005, deg(0.1), describe(update));
       EXPECT_GT(update.pose_covariance.trace(), previous_trace) << describe(update);  // uncertainty grows
       previous_trace = update.pose_covariance.trace();
@@ -228,7 +229,7 @@ TEST(Robustness, AScanTheMapCannotExplainStaysOutOfItAndASecondInARowReanchorsIt
   hglasm::RangeScan foreign = elsewhere(2.1);
   TrackerUpdate update = robot.step(2.1, &foreign);
   ASSERT_TRUE(update.fallback) << describe(update);
-  EXPECT_FALSE(update.reanchored) << describe(update);
+  EXPECT_FALSE(update.diagnostics.reanchored) << describe(update);
   EXPECT_FALSE(update.new_keyframe) << describe(update) << ": an outlier never enters the map";
   const int keyframes = update.keyframe_id;
   update = robot.step(2.2);
@@ -236,10 +237,10 @@ TEST(Robustness, AScanTheMapCannotExplainStaysOutOfItAndASecondInARowReanchorsIt
   expectPoseNear(update.pose, robot.truth(2.2), 0.02, deg(0.3), describe(update));
   foreign = elsewhere(2.3);
   update = robot.step(2.3, &foreign);
-  EXPECT_TRUE(update.fallback && !update.reanchored) << describe(update);
+  EXPECT_TRUE(update.fallback && !update.diagnostics.reanchored) << describe(update);
   foreign = elsewhere(2.4);
   update = robot.step(2.4, &foreign);
-  EXPECT_TRUE(update.reanchored) << describe(update);
+  EXPECT_TRUE(update.diagnostics.reanchored) << describe(update);
   EXPECT_TRUE(update.new_keyframe) << describe(update);
   EXPECT_GT(update.keyframe_id, keyframes);
   EXPECT_EQ(robot.pipeline().localMap().keyframeCount(), 1u) << "the map restarted from it";
@@ -253,7 +254,7 @@ TEST(Robustness, UnusableScansWithoutOdometryKeepTheConstantVelocity) {
     SCOPED_TRACE(what);
     const TrackerUpdate update = robot.step(0.1 * i++, &ranges);
     EXPECT_TRUE(update.fallback) << describe(update);
-    EXPECT_EQ(update.prediction, PredictionSource::kConstantVelocity) << describe(update);
+    EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kConstantVelocity) << describe(update);
   }
   // 0.3 s of constant-velocity prediction on a gentle arc stays within a few millimetres.
   expectPoseNear(robot.pipeline().pose(), robot.truth(0.1 * (i - 1)), 0.01, deg(0.2), "after the bad scans");
@@ -313,7 +314,8 @@ TEST(Robustness, ADriverReconfiguredToAnotherGeometryNeedsNoKeyframe) {
     const TrackerUpdate changed = robot.step(robot.nextTime());
     EXPECT_FALSE(changed.fallback) << describe(changed);
     EXPECT_FALSE(changed.reset) << describe(changed);
-    EXPECT_GT(changed.map_keyframes, 1) << "the map of the earlier scans was kept: " << describe(changed);
+    EXPECT_GT(changed.diagnostics.map_keyframes, 1)
+        << "the map of the earlier scans was kept: " << describe(changed);
     TrackerUpdate update;
     for (int i = 0; i < 12; ++i) {
       update = robot.step(robot.nextTime());
@@ -398,7 +400,7 @@ TEST(Robustness, StampsJumpingForwardByMinutesContinueFromThePose) {
   TrackerUpdate update = robot.stepAt(1.1, 1.1 + offset);
   EXPECT_FALSE(update.reset) << describe(update);
   EXPECT_FALSE(update.fallback) << describe(update);
-  EXPECT_EQ(update.prediction, PredictionSource::kNone) << describe(update);
+  EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kNone) << describe(update);
   for (int i = 12; i <= 30; ++i) {
     update = robot.stepAt(0.1 * i, 0.1 * i + offset);
     EXPECT_FALSE(update.reset) << describe(update);
@@ -487,7 +489,7 @@ TEST(Robustness, ForwardGapsWhileTheWheelsMoveContinueWithinTheWheelsError) {
         update.pose, hglasm_test::relativeByHand(slightlyWrongWheels(3.0), slightlyWrongWheels(after)));
     update = robot.step(after);
     EXPECT_FALSE(update.reset) << describe(update);
-    EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+    EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kOdometry) << describe(update);
     const Pose2D truth = robot.truth(after);
     const double wheel_error = std::hypot(wheel_estimate.x - truth.x, wheel_estimate.y - truth.y);
     const double error = std::hypot(update.pose.x - truth.x, update.pose.y - truth.y);
@@ -525,7 +527,7 @@ TEST(Robustness, AClockJumpingBackAHundredSecondsResetsOnceWithAWarning) {
     update = robot.step(0.1 * i);
     EXPECT_FALSE(update.reset) << describe(update);
     EXPECT_FALSE(update.stale) << describe(update);
-    EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+    EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kOdometry) << describe(update);
   }
   ASSERT_EQ(robot.warnings().size(), 1u) << robot.warnings().back();
   EXPECT_NE(robot.warnings()[0].find("went back by 99.9 s"), std::string::npos) << robot.warnings()[0];
@@ -562,10 +564,10 @@ TEST(Robustness, ScansAlternatingBetween180And181BeamsAndFourStartAnglesNeedNoKe
 // ------------------------------------------------------------------ wheel-odometry faults
 
 TEST(Robustness, LateOdometryFallsBackToConstantVelocityAndIsFlagged) {
-  // Odometry arrives 0.5 s late (a congested network): beyond odometry_max_extrapolation at every scan,
+  // Odometry arrives 0.5 s late (a congested network): beyond max_odometry_extrapolation at every scan,
   // so the tracker must say it predicted with the constant velocity, and still track.
   TrackerOptions options;
-  options.odometry_max_extrapolation = 0.25;
+  options.prediction.max_odometry_extrapolation = 0.25;
   Robot robot(options, circlePath);
   robot.enableOdometry();
   robot.setOdometryDelay(0.5);
@@ -574,8 +576,8 @@ TEST(Robustness, LateOdometryFallsBackToConstantVelocityAndIsFlagged) {
   for (int i = 0; i <= 50; ++i) {
     update = robot.step(0.1 * i);
     if (i == 0) continue;
-    EXPECT_NE(update.prediction, PredictionSource::kOdometry) << describe(update);
-    if (update.prediction == PredictionSource::kConstantVelocity) ++constant_velocity;
+    EXPECT_NE(update.diagnostics.prediction, PredictionSource::kOdometry) << describe(update);
+    if (update.diagnostics.prediction == PredictionSource::kConstantVelocity) ++constant_velocity;
     EXPECT_FALSE(update.fallback) << describe(update);
   }
   EXPECT_GE(constant_velocity, 48);
@@ -587,7 +589,7 @@ TEST(Robustness, LateOdometryFallsBackToConstantVelocityAndIsFlagged) {
   for (int i = 0; i <= 30; ++i) {
     update = slightly_late.step(0.1 * i);
     if (i > 1) {  // at 0.1 s no sample is old enough yet
-      EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+      EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kOdometry) << describe(update);
     }
   }
   expectPoseNear(update.pose, slightly_late.truth(3.0), 0.03, deg(0.5), "slightly late odometry");
@@ -606,11 +608,11 @@ TEST(Robustness, OdometryJumpingTenMetresHasABoundedEffectAndIsFlagged) {
       if (i == 0) continue;
       EXPECT_FALSE(update.fallback) << describe(update);
       if (i == 21) {  // the step over the jump: odometry implausible, constant velocity, one warning
-        EXPECT_EQ(update.prediction, PredictionSource::kConstantVelocity) << describe(update);
+        EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kConstantVelocity) << describe(update);
         EXPECT_NE(update.warning.find("jumped"), std::string::npos) << describe(update);
         ++flagged;
       } else {
-        EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+        EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kOdometry) << describe(update);
       }
       // Bounded: the estimate never leaves the true path.
       expectPoseNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
@@ -664,7 +666,7 @@ TEST(Robustness, FeaturelessCorridorIsUncertainAlongItAndDoesNotJump) {
     TrackerOptions options = with_odometry ? TrackerOptions() : withoutOdometry();
     // The calibrated floor of unexplained error is the same in every direction; what is checked here is
     // what the scan and the wheels know.
-    options.unexplained_xy = options.unexplained_theta = 0.0;
+    options.uncertainty.unexplained_xy = options.uncertainty.unexplained_theta = 0.0;
     Robot robot(options, arcPath(0.5, 0.0), laser, hglasm_test::corridor(1.0, 200.0));
     if (with_odometry) robot.enableOdometry();
     TrackerUpdate update, previous;
@@ -705,7 +707,7 @@ TEST(Fusion, AWheelSlipTheScansContradictIsOverruledAsALeap) {
     const TrackerUpdate update = robot.step(0.1 * i);
     if (i == 0) continue;
     EXPECT_FALSE(update.fallback) << describe(update);
-    EXPECT_EQ(update.prediction, PredictionSource::kOdometry) << describe(update);
+    EXPECT_EQ(update.diagnostics.prediction, PredictionSource::kOdometry) << describe(update);
     leaps += update.leap;
     expectPoseNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
   }
@@ -754,8 +756,9 @@ TEST(Fusion, DownAFeaturelessCorridorTheFusedDistanceIsUnbiased) {
   EXPECT_LT(worst_heading, deg(0.5)) << "and in heading (the wheels end " << wheels_heading << " rad off)";
   EXPECT_GT(wheels_heading, 2.0 * worst_heading) << "the scenario must test the walls";
   // What the scene constrains is reported: nothing along the corridor.
-  EXPECT_LT(update.degeneracy, 1e-3) << describe(update);
-  EXPECT_GT(std::abs(update.weakest_direction.x()), 0.95) << update.weakest_direction.transpose();
+  EXPECT_LT(update.diagnostics.degeneracy, 1e-3) << describe(update);
+  EXPECT_GT(std::abs(update.diagnostics.weakest_direction.x()), 0.95)
+      << update.diagnostics.weakest_direction.transpose();
 }
 
 TEST(Fusion, InACorridorTheWallsGiveTheHeadingAndTheWheelsTheDistance) {
@@ -802,7 +805,7 @@ TEST(Fusion, TheWheelsNoiseIsLearnedFromTheScans) {
       update = robot.step(0.1 * i);
       expectPoseNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
     }
-    return update.noise_scale;
+    return update.diagnostics.learned.wheel_noise;
   };
   const hglasm::MotionNoiseScale exact = drive(1.0);
   const hglasm::MotionNoiseScale bad = drive(1.5);

@@ -56,7 +56,7 @@ TEST(Parameters, NoParametersGiveTheMediumPresetAndDefaults) {
   EXPECT_EQ(options.odom_frame, "odom");
   EXPECT_EQ(options.base_frame, "base_link");
   EXPECT_TRUE(options.publish_tf);
-  EXPECT_TRUE(options.tracker.use_odometry);
+  EXPECT_TRUE(options.tracker.prediction.use_odometry);
   EXPECT_FALSE(options.publish_population);
   EXPECT_GE(options.queue_size, 1);
   EXPECT_FALSE(options.set_pose.topic_enabled) << "the set-pose topic is off by default";
@@ -95,7 +95,7 @@ TEST(Parameters, PresetsYamlThenTopLevelOverridesWin) {
   EXPECT_DOUBLE_EQ(options.tracker.matcher.genetic.box.half_x, 0.5);  // top level beats the preset
   EXPECT_DOUBLE_EQ(options.tracker.keyframe.distance, 0.7);
   EXPECT_EQ(options.odom_frame, "laser_odom");  // leading slash stripped
-  EXPECT_FALSE(options.tracker.use_odometry);
+  EXPECT_FALSE(options.tracker.prediction.use_odometry);
 }
 
 TEST(Parameters, IntegersAreAcceptedWhereNumbersAreExpected) {
@@ -219,19 +219,19 @@ TEST(Parameters, FusionLocalMapAndNoiseParametersAreRead) {
   EXPECT_FALSE(t.fusion);
   EXPECT_EQ(t.local_map.keyframes, 3);
   EXPECT_EQ(t.local_map.resolution, 0.05);
-  EXPECT_EQ(t.leap_probability, 0.01);
-  EXPECT_FALSE(t.noise_learning.learn_wheels);
-  EXPECT_EQ(t.noise_learning.lags, 3);
+  EXPECT_EQ(t.leap.probability, 0.01);
+  EXPECT_FALSE(t.learning.noise.learn_wheels);
+  EXPECT_EQ(t.learning.noise.lags, 3);
   EXPECT_EQ(t.motion.systematic, 0.02);
-  EXPECT_TRUE(t.wheel_calibration.learn);
-  EXPECT_EQ(t.wheel_calibration.turn_scale, 0.2);
-  EXPECT_TRUE(t.noise_learning.learn_scan);
-  EXPECT_FALSE(t.noise_learning.directional);
-  EXPECT_EQ(t.noise_learning.min_scan_scale, 0.5);
+  EXPECT_TRUE(t.learning.wheel_calibration.learn);
+  EXPECT_EQ(t.learning.wheel_calibration.turn_scale, 0.2);
+  EXPECT_TRUE(t.learning.noise.learn_scan);
+  EXPECT_FALSE(t.learning.noise.directional);
+  EXPECT_EQ(t.learning.noise.min_scan_scale, 0.5);
   EXPECT_EQ(t.motion.theta_per_radian, 0.2);
   EXPECT_EQ(t.motion.constant_velocity_xy, 2.0);
-  EXPECT_EQ(t.unexplained_theta, 0.01);
-  EXPECT_EQ(t.min_search_xy, 0.2);
+  EXPECT_EQ(t.uncertainty.unexplained_theta, 0.01);
+  EXPECT_EQ(t.search.min_xy, 0.2);
 }
 
 TEST(Parameters, NonFiniteNumbersAreRejectedExceptAnInfiniteMaxRange) {
@@ -298,22 +298,22 @@ TEST(Parameters, TheTimePolicyAndTheWheelsTimeOffsetAreReadAndValidated) {
   LaserOdometryOptions options;
   std::string error;
   ASSERT_TRUE(loadOptions(XmlRpcValue(), &options, &error)) << error;
-  EXPECT_TRUE(options.tracker.odometry_time_offset.estimate) << "auto by default";
-  EXPECT_EQ(options.tracker.odometry_time_offset.max_offset, 1.0);
+  EXPECT_TRUE(options.tracker.learning.odometry_time_offset.estimate) << "auto by default";
+  EXPECT_EQ(options.tracker.learning.odometry_time_offset.max_offset, 1.0);
   EXPECT_EQ(options.tracker.reset_on_jump_back, 3.0);
   ASSERT_TRUE(loadOptions(params({{"odometry/time_offset", "auto"}, {"odometry/max_time_offset", 2.0}}),
                           &options, &error))
       << error;
-  EXPECT_TRUE(options.tracker.odometry_time_offset.estimate);
-  EXPECT_EQ(options.tracker.odometry_time_offset.max_offset, 2.0);
+  EXPECT_TRUE(options.tracker.learning.odometry_time_offset.estimate);
+  EXPECT_EQ(options.tracker.learning.odometry_time_offset.max_offset, 2.0);
   ASSERT_TRUE(
       loadOptions(params({{"odometry/time_offset", 0.3}, {"time/reset_on_jump_back", 10}}), &options, &error))
       << error;
-  EXPECT_FALSE(options.tracker.odometry_time_offset.estimate) << "a number fixes it";
-  EXPECT_EQ(options.tracker.odometry_time_offset.offset, 0.3);
+  EXPECT_FALSE(options.tracker.learning.odometry_time_offset.estimate) << "a number fixes it";
+  EXPECT_EQ(options.tracker.learning.odometry_time_offset.offset, 0.3);
   EXPECT_EQ(options.tracker.reset_on_jump_back, 10.0);
   ASSERT_TRUE(loadOptions(params({{"odometry/time_offset", -1}}), &options, &error)) << error;
-  EXPECT_EQ(options.tracker.odometry_time_offset.offset, -1.0);
+  EXPECT_EQ(options.tracker.learning.odometry_time_offset.offset, -1.0);
   for (const XmlRpcValue& bad : {XmlRpcValue("automatic"), XmlRpcValue(11.0), XmlRpcValue(true)}) {
     const std::string error_text = loadError(params({{"odometry/time_offset", bad}}));
     EXPECT_NE(error_text.find("~odometry/time_offset must be auto or a number of seconds"), std::string::npos)
@@ -395,7 +395,7 @@ TEST(Parameters, ImuParametersAreReadAndValidated) {
   LaserOdometryOptions options;
   std::string error;
   ASSERT_TRUE(loadOptions(params({}), &options, &error)) << error;
-  EXPECT_FALSE(options.tracker.use_imu) << "off by default";
+  EXPECT_FALSE(options.tracker.prediction.use_imu) << "off by default";
   ASSERT_TRUE(loadOptions(params({{"use_imu", true},
                                   {"imu/use_orientation", true},
                                   {"imu/max_gap", 0.05},
@@ -406,14 +406,14 @@ TEST(Parameters, ImuParametersAreReadAndValidated) {
                                   {"imu/noise/bias_random_walk", 0.001}}),
                           &options, &error))
       << error;
-  EXPECT_TRUE(options.tracker.use_imu);
-  EXPECT_TRUE(options.tracker.imu.use_orientation);
-  EXPECT_EQ(options.tracker.imu.max_gap, 0.05);
-  EXPECT_EQ(options.tracker.imu.angle_random_walk, 0.001);
-  EXPECT_EQ(options.tracker.imu.bias_sigma, 0.0);
-  EXPECT_EQ(options.tracker.imu.scale_error, 0.05);
-  EXPECT_FALSE(options.tracker.imu.estimate_bias);
-  EXPECT_EQ(options.tracker.imu.bias_random_walk, 0.001);
+  EXPECT_TRUE(options.tracker.prediction.use_imu);
+  EXPECT_TRUE(options.tracker.prediction.imu.use_orientation);
+  EXPECT_EQ(options.tracker.prediction.imu.max_gap, 0.05);
+  EXPECT_EQ(options.tracker.prediction.imu.angle_random_walk, 0.001);
+  EXPECT_EQ(options.tracker.prediction.imu.bias_sigma, 0.0);
+  EXPECT_EQ(options.tracker.prediction.imu.scale_error, 0.05);
+  EXPECT_FALSE(options.tracker.prediction.imu.estimate_bias);
+  EXPECT_EQ(options.tracker.prediction.imu.bias_random_walk, 0.001);
   EXPECT_NE(summarize(options).find("IMU orientation in"), std::string::npos) << summarize(options);
   EXPECT_EQ(loadError(params({{"imu/max_gap", 0.0}})),
             "parameter ~imu/max_gap must be a number in [0, 10] and > 0, got 0");

@@ -494,7 +494,7 @@ BagData readReplayedBag(const Settings& settings, LaserOdometryOptions* options)
   EXPECT_TRUE(loadOptions(ros::NodeHandle(settings.odometry_ns), options, &error, &warnings)) << error;
   BagReadOptions read_options;
   read_options.scan_topic = settings.scan_topic;
-  read_options.odom_topic = options->tracker.use_odometry ? settings.wheel_odom_topic : "";
+  read_options.odom_topic = options->tracker.prediction.use_odometry ? settings.wheel_odom_topic : "";
   read_options.base_frame = options->base_frame;
   BagData data;
   EXPECT_TRUE(readBag(settings.bag, read_options, &data, &error)) << error;
@@ -579,7 +579,7 @@ std::map<double, OfflineScan> runOffline(const Settings& settings) {
 }
 
 std::uint8_t predictionSourceOf(const hglasm::TrackerUpdate& update) {
-  switch (update.prediction) {
+  switch (update.diagnostics.prediction) {
     case hglasm::PredictionSource::kOdometry:
       return Match::PREDICTION_ODOMETRY;
     case hglasm::PredictionSource::kConstantVelocity:

@@ -14,6 +14,23 @@ struct KeyframeOptions {
   double min_fitness = 0.0;  ///< a published pose below this fitness ratio makes the scan a keyframe
 };
 
+/// A processed scan as the policy sees it.
+struct KeyframeCandidate {
+  Pose2D pose;                 ///< the base's estimated pose
+  bool usable = false;         ///< enough points to be matched (and to be a keyframe)
+  bool leapt = false;          ///< the estimate leapt from the prediction
+  bool matched = false;        ///< a match was attempted
+  bool match_failed = false;   ///< no match was accepted: the prediction was integrated
+  double fitness_ratio = 0.0;  ///< at the estimated pose
+};
+
+/// What becomes of a scan in the local map.
+enum class KeyframeAction {
+  kNone,        ///< stays out of it
+  kAdd,         ///< becomes a keyframe
+  kRestartMap,  ///< the map restarts from it (it becomes the only keyframe)
+};
+
 /// Not thread-safe per instance.
 class KeyframePolicy {
  public:
@@ -24,12 +41,29 @@ class KeyframePolicy {
   /// pose is below min_fitness.
   bool wantsKeyframe(const Pose2D& pose, bool matched, bool match_failed, double fitness_ratio) const;
 
+  /// What becomes of `scan` in a local map (empty: `map_empty`). A scan without points to match cannot be a
+  /// keyframe, nor one that leapt (the wheels may be right after all, and a keyframe at the leap would hold
+  /// the map to it). A usable scan the map could not explain is an outlier (someone standing in front of
+  /// the laser) and stays out; a second one in a row says the map no longer describes where the robot is
+  /// (it moved during a pause, the surroundings changed): the map restarts from it. Otherwise
+  /// wantsKeyframe(), and always into an empty map.
+  KeyframeAction decide(const KeyframeCandidate& scan, bool map_empty);
+
   /// A keyframe was added with the base at `pose`.
-  void keyframeAdded(const Pose2D& pose) { pose_ = pose; }
+  void keyframeAdded(const Pose2D& pose) {
+    pose_ = pose;
+    ++keyframes_;
+  }
+  /// Keyframes added since construction (the newest keyframe's id).
+  int keyframes() const { return keyframes_; }
+  /// The odometry restarts with an empty map: no scan before counts as unexplained.
+  void restart() { unexplained_scans_ = 0; }
 
  private:
   KeyframeOptions options_;
   Pose2D pose_;  // base pose of the newest keyframe
+  int keyframes_ = 0;
+  int unexplained_scans_ = 0;  // usable scans in a row the map could not explain
 };
 
 }  // namespace hglasm

@@ -119,7 +119,7 @@ class OdometryPipeline {
   /// later one (OdometryBuffer extrapolates by 0 s there instead of interpolating).
   template <typename Iterator>
   Iterator addRecordedOdometry(Iterator next, Iterator end, double stamp) {
-    if (!tracker_.options().use_odometry) return end;
+    if (!tracker_.options().prediction.use_odometry) return end;
     const double wheel_stamp = stamp + odometryTimeOffset();
     for (; next != end && next->stamp <= wheel_stamp; ++next) addOdometry(next->stamp, next->pose);
     for (; next != end && !inputsReadyFor(stamp); ++next) addOdometry(next->stamp, next->pose);
@@ -179,7 +179,6 @@ class OdometryPipeline {
 
   ScanError scan_error_ = ScanError::kNone;
   bool imu_stale_ = false;
-  Pose2D keyframe_pose_;  // base pose of the tracker's current keyframe, for the guess
 };
 
 }  // namespace hglasm

@@ -32,42 +32,51 @@ struct MotionPrediction {
   Eigen::Matrix3d nominal_covariance = Eigen::Matrix3d::Zero();
   /// The rotation (and its variance) came from the IMU; the translation is the wheels' (or the velocity's)
   /// turned by half the difference of the two rotations, as the chord of an arc turns with it.
-  bool gyro = false;
+  bool rotation_from_imu = false;
+};
+
+struct PoseExtrapolatorOptions {
+  bool use_odometry = true;                  ///< predict from wheel odometry at all
+  double max_odometry_extrapolation = 0.25;  ///< seconds past the newest wheel sample; beyond, it is stale
+  /// Wheel motion faster than this between two scans, plus a margin of 0.2 m / 0.2 rad for jitter, is
+  /// implausible (a jump): the velocity predicts instead. The velocity is capped at both too.
+  double max_speed = 5.0;      ///< m/s
+  double max_turn_rate = 6.0;  ///< rad/s
+  /// Take the rotation from the IMU (addImu) whenever its samples cover the interval, with `imu`'s noise
+  /// model; the wheels (or the velocity) predict the translation, and the rotation while the IMU is stale.
+  bool use_imu = false;
+  GyroOptions imu;
 };
 
 /// Not thread-safe per instance.
 class PoseExtrapolator {
  public:
-  /// `use_odometry`: predict from wheel odometry at all. `max_odometry_age`: seconds past the newest sample
-  /// it may be extrapolated. Wheel motion faster than `max_speed` (m/s) or `max_turn_rate` (rad/s), plus a
-  /// margin of 0.2 m / 0.2 rad for jitter, is a jump; the velocity is capped at both too.
-  /// `use_gyro`: take the rotation from the IMU samples (addGyro) whenever they cover the interval.
-  PoseExtrapolator(bool use_odometry, double max_odometry_age, double max_speed, double max_turn_rate,
-                   bool use_gyro = false, const GyroOptions& gyro = {});
+  explicit PoseExtrapolator(const PoseExtrapolatorOptions& options = {});
+  const PoseExtrapolatorOptions& options() const { return options_; }
 
   /// Wheel odometry: pose of the base in the wheel-odometry frame at `stamp`.
   void addOdometry(double stamp, const Pose2D& pose) { odometry_.add(stamp, pose); }
   /// IMU: the base's yaw rate (rad/s), or its yaw (rad) with GyroOptions::use_orientation, at `stamp`.
-  /// Ignored (false) without use_gyro or for non-finite values.
-  bool addGyro(double stamp, double value) { return use_gyro_ && gyro_.add(stamp, value); }
-  /// The gyro's bias (rad/s) and its variance, subtracted from the IMU's rotations from now on.
-  void setGyroBias(double bias, double variance) {
-    gyro_bias_ = bias;
-    gyro_bias_variance_ = variance;
+  /// Ignored (false) without use_imu or for non-finite values.
+  bool addImu(double stamp, double value) { return options_.use_imu && imu_.add(stamp, value); }
+  /// The IMU gyro's bias (rad/s) and its variance, subtracted from the IMU's rotations from now on.
+  void setImuBias(double bias, double variance) {
+    imu_bias_ = bias;
+    imu_bias_variance_ = variance;
   }
-  /// The IMU's rotation of the base from `from` to `to` (bias removed); false without use_gyro or when the
+  /// The IMU's rotation of the base from `from` to `to` (bias removed); false without use_imu or when the
   /// samples do not cover the interval.
-  bool gyroRotation(double from, double to, double* angle) const;
+  bool imuRotation(double from, double to, double* angle) const;
   /// Forgets the wheel odometry (its samples belong to another timeline: its clock went back).
   void clearOdometry() { odometry_.clear(); }
   /// The next prediction starts at the scan stamped `stamp`: the wheels' pose then (at `stamp` plus their
   /// time offset, whatever offset up to `max_offset` is learned meanwhile) stays available.
   void startNextPredictionAt(double stamp, double max_offset) {
     odometry_.keepAround(stamp + odometry_time_offset_, std::abs(max_offset) + 0.5);
-    gyro_.forgetBefore(stamp);
+    imu_.forgetBefore(stamp);
   }
   /// Forgets the IMU samples (another timeline).
-  void clearGyro() { gyro_.clear(); }
+  void clearImu() { imu_.clear(); }
   const OdometryBuffer& odometry() const { return odometry_; }
 
   /// The wheels' systematic errors, removed from their motion before it predicts (learned by the caller).
@@ -103,7 +112,7 @@ class PoseExtrapolator {
  private:
   /// A turn of `angle` in `dt` seconds within max_turn_rate (plus kJitterMargin), whoever measured it.
   bool plausibleTurn(double angle, double dt) const {
-    return std::abs(angle) <= max_turn_rate_ * dt + kJitterMargin;
+    return std::abs(angle) <= options_.max_turn_rate * dt + kJitterMargin;
   }
   static constexpr double kJitterMargin = 0.2;  // m or rad a plausible motion may exceed its rate bound by
   /// The wheels' or the velocity's prediction.
@@ -111,19 +120,15 @@ class PoseExtrapolator {
                                       std::string* warning) const;
   /// Replaces the prediction's rotation by the IMU's, if it covers [from, to] and turns plausibly (else
   /// sets *warning).
-  void applyGyro(double from, double to, MotionPrediction* prediction, std::string* warning) const;
+  void applyImu(double from, double to, MotionPrediction* prediction, std::string* warning) const;
 
-  bool use_odometry_;
-  double max_odometry_age_;
-  double max_speed_;
-  double max_turn_rate_;
+  PoseExtrapolatorOptions options_;
   OdometryBuffer odometry_;
-  bool use_gyro_;
-  GyroBuffer gyro_;
+  GyroBuffer imu_;
   double odometry_time_offset_ = 0.0;
   WheelCalibration calibration_;
-  double gyro_bias_ = 0.0;
-  double gyro_bias_variance_;
+  double imu_bias_ = 0.0;
+  double imu_bias_variance_;
   std::deque<StampedPose> poses_;  // recent estimates, for the velocity
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
   bool velocity_known_ = false;

@@ -1,0 +1,123 @@
+// Whether a scan's pose leaves the predicted motion: two hypotheses compete by posterior probability, "the
+// prediction holds" (its prior) and "the prediction is wrong" (wheel slip, a glitch, a kidnap: a prior as
+// wide as the preset's box). A leap needs the scan's evidence to outweigh the odds against it.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <functional>
+
+#include "hglasm_odometry/core/fitness_monitor.h"
+#include "hglasm_odometry/core/mbicp.h"
+#include "hglasm_odometry/core/pose2d.h"
+#include "hglasm_odometry/core/scan_matcher.h"
+
+namespace hglasm {
+
+struct LeapOptions {
+  /// The prediction is in doubt when the match (or where the scan alone would put the pose) lies farther
+  /// from it than this Mahalanobis distance (3 degrees of freedom), or the scan fits the map this many
+  /// standard deviations worse than matches usually do. Then the preset's whole box is searched too.
+  double max_mahalanobis = 4.0;
+  /// Probability that a prediction is wrong beyond its noise model (prior odds of a leap per scan)...
+  double probability = 1e-3;
+  /// ... and that it stays wrong at the next scan once it was (wheels slip in bursts, a glitch lasts).
+  double persistence = 0.5;
+  /// Outlier share of the scan likelihood that weighs leaps: a point far from the map costs log(outlier).
+  double likelihood_outlier = 0.1;
+};
+
+/// The two hypotheses a scan is matched under, in the local map's frame (the laser's pose).
+struct LeapHypotheses {
+  PosePrior prior;  ///< the prediction holds
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  PosePrior wide_prior;  ///< the prediction is wrong: the pose anywhere in the preset's box
+  Eigen::Matrix3d wide_covariance = Eigen::Matrix3d::Zero();
+  double wrong_probability = 0.0;  ///< prior probability of the second
+};
+
+/// A match and how well it explains the scan.
+struct MatchCandidate {
+  MatchResult match;
+  double fitness_ratio = 0.0;   ///< of the scan at the match's pose
+  bool acceptable = false;      ///< usable, and fits at least min_fitness
+  double mahalanobis_sq = 0.0;  ///< from the prediction
+};
+
+/// The log posteriors (up to a common constant) of one match under the two hypotheses.
+struct LogPosteriors {
+  double prediction_holds = -HUGE_VAL;
+  double prediction_wrong = -HUGE_VAL;
+  double best() const { return std::max(prediction_holds, prediction_wrong); }
+  /// Posterior probability that the prediction is wrong.
+  double wrongProbability() const { return 1.0 / (1.0 + std::exp(prediction_holds - prediction_wrong)); }
+  /// Both times a further likelihood of the match.
+  void add(double log_likelihood) {
+    prediction_holds += log_likelihood;
+    prediction_wrong += log_likelihood;
+  }
+};
+
+/// What the leap test made of one scan.
+struct LeapVerdict {
+  MatchCandidate chosen;           ///< the tight match, or the wide one if it won (costs of both summed)
+  bool doubted = false;            ///< the prediction was in doubt: the preset's box was searched too
+  bool wide = false;               ///< the wide search's match won
+  bool leapt = false;              ///< ... and lies beyond max_mahalanobis of the prediction
+  bool rejected = false;           ///< a wide match that far lacked the evidence: the prediction held
+  double wrong_probability = 0.0;  ///< posterior probability that the prediction was wrong
+};
+
+/// Its one piece of state is how likely the last scan's prediction was wrong: the next scan's prior odds
+/// follow it. Not thread-safe per instance.
+class LeapDetector {
+ public:
+  explicit LeapDetector(const LeapOptions& options = {});
+
+  /// The hypotheses for the laser's predicted pose `mean` with `covariance`; a wrong prediction widens it
+  /// by `box_variances` (boxVariances of the preset's box).
+  LeapHypotheses hypotheses(const Pose2D& mean, const Eigen::Matrix3d& covariance,
+                            const Eigen::Vector3d& box_variances) const;
+
+  /// Whether the prediction is in doubt after the `tight` match near it: the match, or where the scan alone
+  /// would put the pose, lies beyond max_mahalanobis (both uncertainties counted; directions the scan does
+  /// not constrain carry no innovation), nothing acceptable fits, or it fits worse than usual.
+  bool inDoubt(const MatchCandidate& tight, const LeapHypotheses& h, const FitnessMonitor& fitness) const;
+
+  /// Each hypothesis' evidence for a match, in the Laplace approximation: the scan's likelihood at the pose,
+  /// the hypothesis' prior density there, and the volume of the posterior around it (a hypothesis that
+  /// leaves a direction to the scan, and the scan leaves it open too, loses no probability for it).
+  LogPosteriors logPosteriors(const ScanJudge& judge, const LeapHypotheses& h,
+                              const MatchResult& match) const;
+
+  /// Log posterior of "the prediction holds" at the predicted pose itself, for when nothing near it is
+  /// acceptable: a scan that says little there (an occluded or changed view), not nothing.
+  double predictionLogPosterior(const ScanJudge& judge, const LeapHypotheses& h) const;
+
+  /// The test of one scan: `tight` is the match near the prediction (under h.prior). If `search_wide` is
+  /// given the prediction was in doubt: it searches the preset's box under the second hypothesis, and the
+  /// two matches compete by posterior, with the beams' free space (which the likelihood field leaves out: a
+  /// scan occluded by people fits the map better turned onto another corridor, with beams through its
+  /// walls). `informative`: the prior holds information (else no posterior is formed).
+  LeapVerdict test(const ScanJudge& judge, const LeapHypotheses& h, bool informative,
+                   const MatchCandidate& tight, const std::function<MatchCandidate()>& search_wide) const;
+
+  /// The probability that this scan's prediction was wrong (a verdict's): the next scan's prior follows it.
+  void remember(double wrong_probability) { wrong_probability_ = wrong_probability; }
+  /// The prior probability that the prediction of the coming scan is wrong.
+  double wrongPrior() const;
+  /// The probability remembered last (0 after reset()).
+  double wrongProbability() const { return wrong_probability_; }
+  /// Beyond max_mahalanobis of the prediction.
+  bool far(const MatchCandidate& candidate) const {
+    return candidate.mahalanobis_sq > options_.max_mahalanobis * options_.max_mahalanobis;
+  }
+  void reset() { wrong_probability_ = 0.0; }
+  const LeapOptions& options() const { return options_; }
+
+ private:
+  LeapOptions options_;
+  double wrong_probability_ = 0.0;
+};
+
+}  // namespace hglasm

@@ -1,0 +1,112 @@
+#include "hglasm_odometry/core/leap_detector.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+
+#include "hglasm_odometry/core/covariance.h"
+
+namespace hglasm {
+namespace {
+
+double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3d& covariance) {
+  return logNormalDensity(poseDifference(pose, prior.mean), prior.information, covariance);
+}
+
+}  // namespace
+
+LeapDetector::LeapDetector(const LeapOptions& options) : options_(options) {}
+
+double LeapDetector::wrongPrior() const {
+  // A prediction that was wrong tends to stay wrong for a while.
+  return std::clamp(
+      (1.0 - wrong_probability_) * options_.probability + wrong_probability_ * options_.persistence, 1e-12,
+      1.0 - 1e-12);
+}
+
+LeapHypotheses LeapDetector::hypotheses(const Pose2D& mean, const Eigen::Matrix3d& covariance,
+                                        const Eigen::Vector3d& box_variances) const {
+  LeapHypotheses h;
+  h.covariance = covariance;
+  h.prior.mean = mean;
+  h.prior.information = informationOf(h.covariance);
+  h.wide_covariance = h.covariance;
+  h.wide_covariance.diagonal() += box_variances;
+  h.wide_prior = PosePrior{h.prior.mean, informationOf(h.wide_covariance)};
+  h.wrong_probability = wrongPrior();
+  return h;
+}
+
+bool LeapDetector::inDoubt(const MatchCandidate& tight, const LeapHypotheses& h,
+                           const FitnessMonitor& fitness) const {
+  const double gate_sq = options_.max_mahalanobis * options_.max_mahalanobis;
+  if (!tight.acceptable || tight.mahalanobis_sq > gate_sq) return true;
+  // The scan fits the map far worse than scans usually do: the pose near the prediction is not its place.
+  if (!fitness.usual(tight.fitness_ratio)) return true;
+  const Eigen::Vector3d innovation = poseDifference(tight.match.scan_only_pose, h.prior.mean);
+  const Eigen::Matrix3d total = h.covariance + covarianceOfInformation(tight.match.scan_information);
+  const double innovation_sq = innovation.dot(total.ldlt().solve(innovation));
+  return !(innovation_sq <= gate_sq);
+}
+
+LogPosteriors LeapDetector::logPosteriors(const ScanJudge& judge, const LeapHypotheses& h,
+                                          const MatchResult& match) const {
+  const double likelihood = judge.logLikelihood(match.pose);
+  const auto log_volume = [&](const PosePrior& hypothesis) {
+    return 0.5 * logDet2Pi(informationOf(match.scan_information + hypothesis.information));
+  };
+  LogPosteriors posteriors;
+  posteriors.prediction_holds = likelihood + logPrior(match.pose, h.prior, h.covariance) +
+                                log_volume(h.prior) + std::log1p(-h.wrong_probability);
+  posteriors.prediction_wrong = likelihood + logPrior(match.pose, h.wide_prior, h.wide_covariance) +
+                                log_volume(h.wide_prior) + std::log(h.wrong_probability);
+  return posteriors;
+}
+
+double LeapDetector::predictionLogPosterior(const ScanJudge& judge, const LeapHypotheses& h) const {
+  // Its posterior volume is the prior's.
+  const double log_volume = 0.5 * logDet2Pi(h.covariance);
+  return judge.logLikelihood(h.prior.mean) + judge.freeSpaceLogLikelihood(h.prior.mean) +
+         logPrior(h.prior.mean, h.prior, h.covariance) + log_volume + std::log1p(-h.wrong_probability);
+}
+
+LeapVerdict LeapDetector::test(const ScanJudge& judge, const LeapHypotheses& h, bool informative,
+                               const MatchCandidate& tight,
+                               const std::function<MatchCandidate()>& search_wide) const {
+  LeapVerdict verdict;
+  verdict.chosen = tight;
+  verdict.wrong_probability = h.wrong_probability;
+  LogPosteriors stay;
+  if (informative && tight.acceptable) {
+    stay = logPosteriors(judge, h, tight.match);
+    verdict.wrong_probability = stay.wrongProbability();
+  }
+  if (search_wide) {
+    verdict.doubted = true;
+    const MatchCandidate wide = search_wide();
+    const double stay_score = tight.acceptable ? stay.best() + judge.freeSpaceLogLikelihood(tight.match.pose)
+                                               : predictionLogPosterior(judge, h);
+    LogPosteriors leap;
+    if (wide.acceptable) {
+      leap = logPosteriors(judge, h, wide.match);
+      leap.add(judge.freeSpaceLogLikelihood(wide.match.pose));
+    }
+    const MatchCandidate* loser = &wide;
+    if (leap.best() > stay_score) {
+      verdict.chosen = wide;
+      verdict.wide = true;
+      verdict.leapt = far(wide);
+      verdict.wrong_probability = leap.wrongProbability();
+      loser = &tight;
+    } else {
+      verdict.rejected = wide.acceptable && far(wide);
+    }
+    // Both searches cost time and evaluations.
+    verdict.chosen.match.prealign_ms += loser->match.prealign_ms;
+    verdict.chosen.match.refine_ms += loser->match.refine_ms;
+    verdict.chosen.match.evaluations += loser->match.evaluations;
+  }
+  if (!verdict.chosen.acceptable) verdict.wrong_probability = h.wrong_probability;
+  return verdict;
+}
+
+}  // namespace hglasm

@@ -1,0 +1,190 @@
+// The leap test: the two hypotheses' priors, when the prediction is in doubt, and the competition of the
+// match near the prediction with the wide search's, on a room whose scan is judged where it was taken.
+#include "hglasm_odometry/core/leap_detector.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "hglasm_odometry/core/covariance.h"
+#include "hglasm_odometry/core/search_sizing.h"
+#include "test_util.h"
+
+namespace {
+
+using hglasm::LeapDetector;
+using hglasm::LeapHypotheses;
+using hglasm::LeapVerdict;
+using hglasm::LogPosteriors;
+using hglasm::MatchCandidate;
+using hglasm::Pose2D;
+
+/// A room scanned from the origin: the map is the scan itself, so the truth is the identity.
+struct Room {
+  hglasm::Scan scan =
+      hglasm_test::simulateScan(hglasm_test::room(), Pose2D(), hglasm_test::fullCircleLaser());
+  hglasm::LookupTable table;
+  Room() { table.build(scan.points); }
+  hglasm::ScanJudge judge() const { return hglasm::ScanJudge(table, scan, 100.0 / scan.size(), 0.1); }
+};
+
+const Eigen::Vector3d kBoxVariances = hglasm::boxVariances(hglasm::SearchBox{1.0, 1.0, 1.0}, 4.0);
+
+/// A match at `pose` (a confident scan) judged against the prediction `h`.
+MatchCandidate candidateAt(const Pose2D& pose, const LeapHypotheses& h, const hglasm::ScanJudge& judge) {
+  MatchCandidate candidate;
+  candidate.match.pose = candidate.match.scan_only_pose = pose;
+  candidate.match.status = hglasm::MatchStatus::kOk;
+  candidate.match.scan_information = Eigen::Vector3d(1e4, 1e4, 1e5).asDiagonal();
+  candidate.match.prealign_ms = 1.0;
+  candidate.match.evaluations = 100;
+  const Eigen::Vector3d offset = hglasm::poseDifference(pose, h.prior.mean);
+  candidate.mahalanobis_sq = offset.dot(h.prior.information * offset);
+  candidate.fitness_ratio = judge.fitnessRatio(pose);
+  candidate.acceptable = candidate.fitness_ratio >= 0.15;
+  return candidate;
+}
+
+TEST(LeapDetector, TheWrongHypothesisIsWiderAndItsOddsFollowTheLastScan) {
+  LeapDetector detector;
+  const Eigen::Matrix3d covariance = Eigen::Vector3d(0.01, 0.01, 0.001).asDiagonal();
+  LeapHypotheses h = detector.hypotheses(Pose2D(1.0, 2.0, 0.3), covariance, kBoxVariances);
+  EXPECT_EQ(h.prior.mean.x, 1.0);
+  EXPECT_TRUE(h.prior.information.isApprox(hglasm::informationOf(covariance)));
+  EXPECT_TRUE(h.wide_covariance.isApprox(covariance + kBoxVariances.asDiagonal().toDenseMatrix()));
+  EXPECT_EQ(h.wide_prior.mean.y, 2.0);
+  EXPECT_DOUBLE_EQ(h.wrong_probability, 1e-3) << "leap/probability";
+  // A scan whose prediction was surely wrong: the next one's is wrong with leap/persistence.
+  const Room room;
+  MatchCandidate nothing;
+  const LeapVerdict verdict = detector.test(room.judge(), h, true, nothing, [&] {
+    MatchCandidate truth = candidateAt(Pose2D(), h, room.judge());
+    return truth;
+  });
+  ASSERT_TRUE(verdict.wide);
+  EXPECT_GT(verdict.wrong_probability, 0.999);
+  EXPECT_DOUBLE_EQ(detector.wrongPrior(), 1e-3) << "testing changes nothing";
+  detector.remember(verdict.wrong_probability);
+  EXPECT_EQ(detector.wrongProbability(), verdict.wrong_probability);
+  EXPECT_NEAR(detector.wrongPrior(), 0.5, 1e-3);
+  detector.reset();
+  EXPECT_DOUBLE_EQ(detector.wrongPrior(), 1e-3);
+}
+
+TEST(LeapDetector, APredictionIsInDoubtWhenTheMatchOrTheScanAloneLeavesIt) {
+  const Room room;
+  const LeapDetector detector;
+  const LeapHypotheses h =
+      detector.hypotheses(Pose2D(), Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal(), kBoxVariances);
+  hglasm::FitnessMonitor fitness(4.0);
+  MatchCandidate near = candidateAt(Pose2D(0.005, 0.0, 0.0), h, room.judge());
+  ASSERT_TRUE(near.acceptable);
+  EXPECT_FALSE(detector.inDoubt(near, h, fitness));
+  MatchCandidate far = candidateAt(Pose2D(0.2, 0.0, 0.0), h, room.judge());
+  EXPECT_TRUE(detector.inDoubt(far, h, fitness)) << "20 sigma from the prediction";
+  MatchCandidate scan_left = near;
+  scan_left.match.scan_only_pose = Pose2D(0.2, 0.0, 0.0);
+  EXPECT_TRUE(detector.inDoubt(scan_left, h, fitness)) << "the scan alone puts it elsewhere";
+  MatchCandidate unacceptable = near;
+  unacceptable.acceptable = false;
+  EXPECT_TRUE(detector.inDoubt(unacceptable, h, fitness));
+  for (int i = 0; i < 10; ++i) fitness.add(0.99);
+  MatchCandidate poor = near;
+  poor.fitness_ratio = 0.5;
+  EXPECT_TRUE(detector.inDoubt(poor, h, fitness)) << "fits far worse than matches usually do";
+}
+
+TEST(LeapDetector, ScoresPreferTheHypothesisWhosePriorHoldsTheMatch) {
+  const Room room;
+  const LeapDetector detector;
+  const LeapHypotheses h =
+      detector.hypotheses(Pose2D(), Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal(), kBoxVariances);
+  const LogPosteriors at_prediction =
+      detector.logPosteriors(room.judge(), h, candidateAt(Pose2D(), h, room.judge()).match);
+  EXPECT_GT(at_prediction.prediction_holds, at_prediction.prediction_wrong);
+  EXPECT_LT(at_prediction.wrongProbability(), 1e-3);
+  const Pose2D away(0.3, 0.0, 0.0);
+  const LogPosteriors far = detector.logPosteriors(room.judge(), h, candidateAt(away, h, room.judge()).match);
+  EXPECT_LT(far.prediction_holds, far.prediction_wrong);
+  EXPECT_GT(far.wrongProbability(), 0.5);
+  // The prediction itself: its prior density there and its posterior volume (the prior's) cancel.
+  const hglasm::ScanJudge judge = room.judge();
+  EXPECT_NEAR(detector.predictionLogPosterior(judge, h),
+              judge.logLikelihood(Pose2D()) + judge.freeSpaceLogLikelihood(Pose2D()) +
+                  std::log1p(-h.wrong_probability),
+              1e-9);
+}
+
+TEST(LeapDetector, WithoutDoubtTheTightMatchStandsAndConfirmsThePrediction) {
+  const Room room;
+  LeapDetector detector;
+  const LeapHypotheses h =
+      detector.hypotheses(Pose2D(), Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal(), kBoxVariances);
+  const MatchCandidate tight = candidateAt(Pose2D(0.002, 0.0, 0.0), h, room.judge());
+  const LeapVerdict verdict = detector.test(room.judge(), h, true, tight, nullptr);
+  EXPECT_FALSE(verdict.doubted);
+  EXPECT_FALSE(verdict.wide);
+  EXPECT_EQ(verdict.chosen.match.pose.x, 0.002);
+  EXPECT_LT(verdict.wrong_probability, h.wrong_probability) << "the match confirmed the prediction";
+  // Uninformative (no fusion, no prediction): no posterior is formed, the prior odds stand.
+  const LeapVerdict flat = detector.test(room.judge(), h, false, tight, nullptr);
+  EXPECT_EQ(flat.wrong_probability, h.wrong_probability);
+}
+
+TEST(LeapDetector, AWideMatchWithTheEvidenceLeapsAndBothSearchesAreCounted) {
+  // The wheels put the robot 0.4 m from where it is: the match near them fits poorly, the wide one fits.
+  const Room room;
+  LeapDetector detector;
+  const LeapHypotheses h = detector.hypotheses(Pose2D(0.4, 0.0, 0.0),
+                                               Eigen::Vector3d(1e-3, 1e-3, 1e-4).asDiagonal(), kBoxVariances);
+  const MatchCandidate tight = candidateAt(Pose2D(0.38, 0.0, 0.0), h, room.judge());
+  int searches = 0;
+  const LeapVerdict verdict = detector.test(room.judge(), h, true, tight, [&] {
+    ++searches;
+    return candidateAt(Pose2D(), h, room.judge());
+  });
+  EXPECT_EQ(searches, 1);
+  EXPECT_TRUE(verdict.doubted);
+  EXPECT_TRUE(verdict.wide);
+  EXPECT_TRUE(verdict.leapt) << "far beyond 4 sigma";
+  EXPECT_FALSE(verdict.rejected);
+  EXPECT_EQ(verdict.chosen.match.pose.x, 0.0);
+  EXPECT_EQ(verdict.chosen.match.prealign_ms, 2.0);
+  EXPECT_EQ(verdict.chosen.match.evaluations, 200);
+  EXPECT_GT(verdict.wrong_probability, 0.5);
+}
+
+TEST(LeapDetector, AWideMatchWithoutTheEvidenceIsRejected) {
+  // The wheels are right; the wide search found a worse fit far away.
+  const Room room;
+  LeapDetector detector;
+  const LeapHypotheses h =
+      detector.hypotheses(Pose2D(), Eigen::Vector3d(1e-3, 1e-3, 1e-4).asDiagonal(), kBoxVariances);
+  const MatchCandidate tight = candidateAt(Pose2D(0.01, 0.0, 0.0), h, room.judge());
+  MatchCandidate wide = candidateAt(Pose2D(0.5, 0.3, 0.2), h, room.judge());
+  wide.acceptable = true;  // acceptable by the fitness floor, but a worse fit
+  const LeapVerdict verdict = detector.test(room.judge(), h, true, tight, [&] { return wide; });
+  EXPECT_TRUE(verdict.doubted);
+  EXPECT_FALSE(verdict.wide);
+  EXPECT_FALSE(verdict.leapt);
+  EXPECT_TRUE(verdict.rejected);
+  EXPECT_EQ(verdict.chosen.match.pose.x, 0.01);
+  EXPECT_EQ(verdict.chosen.match.evaluations, 200) << "the wide search's cost counts too";
+  EXPECT_LT(verdict.wrong_probability, 0.5);
+}
+
+TEST(LeapDetector, NothingAcceptableKeepsThePriorOdds) {
+  const Room room;
+  LeapDetector detector;
+  const LeapHypotheses h =
+      detector.hypotheses(Pose2D(), Eigen::Vector3d(1e-3, 1e-3, 1e-4).asDiagonal(), kBoxVariances);
+  MatchCandidate tight = candidateAt(Pose2D(), h, room.judge());
+  tight.acceptable = false;
+  MatchCandidate wide = tight;
+  const LeapVerdict verdict = detector.test(room.judge(), h, true, tight, [&] { return wide; });
+  EXPECT_TRUE(verdict.doubted);
+  EXPECT_FALSE(verdict.chosen.acceptable);
+  EXPECT_EQ(verdict.wrong_probability, h.wrong_probability);
+}
+
+}  // namespace
