@@ -60,12 +60,16 @@ const LookupTable& LocalMap::table(std::size_t index) const {
 
 void LocalMap::insert(Submap* submap, const Pose2D& laser_pose, const std::vector<Eigen::Vector2d>& points) {
   const Pose2D pose = submap->anchor.inverse() * laser_pose;
+  transformPoints(points, pose, &moved_);
   // A keyframe is never thinned by its own points (its beams keep their spacing), only by older ones':
   // where keyframes overlap the oldest view stays, so the map holds its shape while the robot moves
   // through it instead of following the newest keyframe's error.
+  const double cell_size = 2.0 * options_.resolution;
   covered_.assign(points.size(), 0);
   if (options_.resolution > 0.0) {
-    for (std::size_t i = 0; i < points.size(); ++i) covered_[i] = covered(*submap, pose * points[i]);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      covered_[i] = !onGrid(moved_[i]) || submap->grid.anyWithin(moved_[i], options_.resolution, cell_size);
+    }
   }
   // A kept point keeps its neighbouring beams too, covered or not: the surface it lies on stays a surface
   // (alone, a thinned wall's survivors would be isolated points, precise along their beams, which along a
@@ -80,7 +84,7 @@ void LocalMap::insert(Submap* submap, const Pose2D& laser_pose, const std::vecto
   submap->points.append(kept_, pose);
   if (options_.resolution > 0.0) {
     for (const Eigen::Vector2d& point : added_.points) {
-      if (onGrid(point)) submap->cells[cellKey(point, 0, 0)].push_back(point);
+      if (onGrid(point)) submap->grid.add(point, cell_size);
     }
   }
   for (LookupTable& table : submap->tables) table.insert(added_);
@@ -117,24 +121,67 @@ void LocalMap::appendNewest() {
   }
 }
 
-std::uint64_t LocalMap::cellKey(const Eigen::Vector2d& point, int dx, int dy) const {
-  const double inverse = 1.0 / options_.resolution;
-  const std::int64_t cx = static_cast<std::int64_t>(std::floor(point.x() * inverse)) + dx;
-  const std::int64_t cy = static_cast<std::int64_t>(std::floor(point.y() * inverse)) + dy;
+void LocalMap::PointGrid::clear() {
+  slots_.clear();
+  points_.clear();
+  next_.clear();
+  used_ = 0;
+}
+
+std::uint64_t LocalMap::PointGrid::keyOf(std::int64_t cx, std::int64_t cy) {
   // Two's-complement bits of each coordinate, side by side (points are within 1e6 m, so 32 bits each).
   return (static_cast<std::uint64_t>(cx) << 32) ^ (static_cast<std::uint64_t>(cy) & 0xffffffffu);
 }
 
-bool LocalMap::covered(const Submap& submap, const Eigen::Vector2d& point) const {
-  if (!onGrid(point)) return true;
-  const double limit_sq = options_.resolution * options_.resolution;
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      const auto it = submap.cells.find(cellKey(point, dx, dy));
-      if (it == submap.cells.end()) continue;
-      for (const auto& other : it->second) {
-        if ((other - point).squaredNorm() < limit_sq) return true;
-      }
+int LocalMap::PointGrid::headOf(std::uint64_t key) const {
+  if (slots_.empty()) return -1;
+  const std::size_t mask = slots_.size() - 1;
+  for (std::size_t i = (key * 0x9E3779B97F4A7C15ull) >> 40 & mask;; i = (i + 1) & mask) {
+    if (slots_[i].head < 0) return -1;
+    if (slots_[i].key == key) return slots_[i].head;
+  }
+}
+
+void LocalMap::PointGrid::grow() {
+  std::vector<Slot> old;
+  old.swap(slots_);
+  slots_.assign(std::max<std::size_t>(64, 2 * old.size()), Slot());
+  const std::size_t mask = slots_.size() - 1;
+  for (const Slot& slot : old) {
+    if (slot.head < 0) continue;
+    std::size_t i = (slot.key * 0x9E3779B97F4A7C15ull) >> 40 & mask;
+    while (slots_[i].head >= 0) i = (i + 1) & mask;
+    slots_[i] = slot;
+  }
+}
+
+void LocalMap::PointGrid::add(const Eigen::Vector2d& point, double cell_size) {
+  if (2 * (used_ + 1) > slots_.size()) grow();
+  const std::uint64_t key = keyOf(static_cast<std::int64_t>(std::floor(point.x() / cell_size)),
+                                  static_cast<std::int64_t>(std::floor(point.y() / cell_size)));
+  const std::size_t mask = slots_.size() - 1;
+  std::size_t i = (key * 0x9E3779B97F4A7C15ull) >> 40 & mask;
+  while (slots_[i].head >= 0 && slots_[i].key != key) i = (i + 1) & mask;
+  if (slots_[i].head < 0) {
+    slots_[i].key = key;
+    ++used_;
+  }
+  next_.push_back(slots_[i].head);
+  slots_[i].head = static_cast<int>(points_.size());
+  points_.push_back(point);
+}
+
+bool LocalMap::PointGrid::anyWithin(const Eigen::Vector2d& point, double radius, double cell_size) const {
+  const double fx = point.x() / cell_size, fy = point.y() / cell_size;
+  const std::int64_t cx = static_cast<std::int64_t>(std::floor(fx));
+  const std::int64_t cy = static_cast<std::int64_t>(std::floor(fy));
+  // The disk reaches the neighbouring cell on the side of the cell's centre it lies on.
+  const std::int64_t nx = fx - static_cast<double>(cx) < 0.5 ? cx - 1 : cx + 1;
+  const std::int64_t ny = fy - static_cast<double>(cy) < 0.5 ? cy - 1 : cy + 1;
+  const double radius_sq = radius * radius;
+  for (const std::uint64_t key : {keyOf(cx, cy), keyOf(nx, cy), keyOf(cx, ny), keyOf(nx, ny)}) {
+    for (int k = headOf(key); k >= 0; k = next_[k]) {
+      if ((points_[k] - point).squaredNorm() < radius_sq) return true;
     }
   }
   return false;

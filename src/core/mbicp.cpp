@@ -188,37 +188,33 @@ void Mbicp::mergeByBearing(std::size_t old_count) {
   // The new points sorted by (bearing, index), merged with the sorted old ones: the order a full sort of
   // all of them gives, in time linear in the old ones.
   const std::size_t n = ref_points_.size();
-  std::vector<std::pair<double, int>> added;
-  added.reserve(n - old_count);
+  std::vector<std::pair<double, int>>& added = added_scratch_;
+  added.clear();
   for (std::size_t i = old_count; i < n; ++i) {
     added.emplace_back(fastAtan2(ref_points_[i].y(), ref_points_[i].x()), static_cast<int>(i));
   }
   std::sort(added.begin(), added.end());
-  std::vector<int> index;
-  std::vector<double> bearing;
-  std::vector<WalkEntry> walk;
-  index.reserve(n);
-  bearing.reserve(n);
-  walk.reserve(n);
-  std::size_t a = 0, b = 0;
-  while (a < old_count || b < added.size()) {
-    // Old indices are all smaller than new ones: at equal bearings the old point comes first.
-    const bool take_old = b == added.size() || (a < old_count && sorted_bearing_[a] <= added[b].first);
-    if (take_old) {
-      index.push_back(sorted_index_[a]);
-      bearing.push_back(sorted_bearing_[a]);
-      walk.push_back(walk_[a]);
-      ++a;
+  // Merged in place from the back: the larger bearing last; at equal bearings the new point (its index is
+  // the larger) goes after the old one.
+  sorted_index_.resize(n);
+  sorted_bearing_.resize(n);
+  walk_.resize(n);
+  std::ptrdiff_t old_k = static_cast<std::ptrdiff_t>(old_count) - 1;
+  for (std::ptrdiff_t b = static_cast<std::ptrdiff_t>(added.size()) - 1,
+                      k = static_cast<std::ptrdiff_t>(n) - 1;
+       b >= 0; --k) {
+    if (old_k >= 0 && sorted_bearing_[old_k] > added[b].first) {
+      sorted_index_[k] = sorted_index_[old_k];
+      sorted_bearing_[k] = sorted_bearing_[old_k];
+      walk_[k] = walk_[old_k];
+      --old_k;
     } else {
-      index.push_back(added[b].second);
-      bearing.push_back(added[b].first);
-      walk.push_back(walkEntry(added[b].second));
-      ++b;
+      sorted_index_[k] = added[b].second;
+      sorted_bearing_[k] = added[b].first;
+      walk_[k] = walkEntry(added[b].second);
+      --b;
     }
   }
-  sorted_index_.swap(index);
-  sorted_bearing_.swap(bearing);
-  walk_.swap(walk);
   // Each of the n equal buckets starts at the first point at or past its lower edge.
   const std::size_t buckets = std::max<std::size_t>(n, 1);
   bucket_first_.assign(buckets + 1, static_cast<int>(n));

@@ -12,16 +12,28 @@ using hglasm::GeneticOptions;
 using hglasm::SearchEffort;
 using hglasm::SearchOptions;
 
-TEST(SearchSizing, ATightPredictionGetsTheFloorAndTheSmallPresetsGa) {
+TEST(SearchSizing, ATightPredictionGetsTheFloorAndASmallerGaThanTheSmallPresets) {
   const GeneticOptions medium = hglasm::presetOptions(hglasm::Preset::kMedium).genetic;
   const SearchEffort effort =
       hglasm::searchAround(medium, SearchOptions(), Eigen::Vector3d(1e-6, 1e-6, 1e-8).asDiagonal());
   EXPECT_EQ(effort.box.half_x, 0.10);
   EXPECT_EQ(effort.box.half_y, 0.10);
   EXPECT_EQ(effort.box.half_theta, 0.05);
+  // The floor box is a third of the small preset's on every axis: half its population, 2/3 of its
+  // generations.
+  EXPECT_EQ(effort.population, 10);
+  EXPECT_EQ(effort.generations, 4);
+  EXPECT_EQ(effort.coarse_generations, 0);
+}
+
+TEST(SearchSizing, ABoxBeyondAThirdOfTheSmallPresetsOnOneAxisGetsTheSmallPresetsGa) {
+  const GeneticOptions medium = hglasm::presetOptions(hglasm::Preset::kMedium).genetic;
+  // x: 4 sigma = 0.12 m, beyond a third of 0.3 m; y and theta at the floor.
+  const SearchEffort effort =
+      hglasm::searchAround(medium, SearchOptions(), Eigen::Vector3d(0.0009, 1e-6, 1e-8).asDiagonal());
+  EXPECT_NEAR(effort.box.half_x, 0.12, 1e-12);
   EXPECT_EQ(effort.population, 20);
   EXPECT_EQ(effort.generations, 6);
-  EXPECT_EQ(effort.coarse_generations, 0);
 }
 
 TEST(SearchSizing, TheBoxIsSigmasStandardDeviationsCappedByThePresets) {
@@ -38,10 +50,10 @@ TEST(SearchSizing, TheBoxIsSigmasStandardDeviationsCappedByThePresets) {
 
 TEST(SearchSizing, NeverMoreThanTheConfiguredPresetsGa) {
   GeneticOptions tiny = hglasm::presetOptions(hglasm::Preset::kMedium).genetic;
-  tiny.population = 10;
+  tiny.population = 8;
   tiny.generations = 3;
   const SearchEffort effort = hglasm::searchAround(tiny, SearchOptions(), Eigen::Matrix3d::Zero());
-  EXPECT_EQ(effort.population, 10);
+  EXPECT_EQ(effort.population, 8);
   EXPECT_EQ(effort.generations, 3);
   EXPECT_EQ(effort.coarse_generations, 0);
 }

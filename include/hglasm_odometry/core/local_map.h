@@ -6,7 +6,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
-#include <unordered_map>
 #include <vector>
 
 #include "hglasm_odometry/core/lookup_table.h"
@@ -69,18 +68,37 @@ class LocalMap {
   std::uint64_t revision() const { return revision_; }
 
  private:
+  /// Points by cells twice the resolution wide, so a disk of the resolution's radius meets at most 2 x 2 of
+  /// them; cells in an open-addressing table, each cell's points a linked list.
+  class PointGrid {
+   public:
+    void clear();
+    void add(const Eigen::Vector2d& point, double cell_size);
+    /// True if a point of the grid lies closer than `radius` (half the cell size) to `point`.
+    bool anyWithin(const Eigen::Vector2d& point, double radius, double cell_size) const;
+
+   private:
+    struct Slot {
+      std::uint64_t key = 0;
+      int head = -1;  // newest point of the cell; -1: an empty slot
+    };
+    static std::uint64_t keyOf(std::int64_t cx, std::int64_t cy);
+    int headOf(std::uint64_t key) const;
+    void grow();
+    std::vector<Slot> slots_;
+    std::vector<Eigen::Vector2d> points_;
+    std::vector<int> next_;  // per point: the previous point of its cell (-1: none)
+    std::size_t used_ = 0;
+  };
   struct Submap {
     Pose2D anchor;           // laser pose of its first keyframe, odometry frame: the frame of points
     ReferencePoints points;  // kept points of its keyframes, one scan per keyframe
     std::vector<LookupTable> tables;
-    std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> cells;  // kept points by grid cell
+    PointGrid grid;  // kept points, for the de-duplication
     int keyframes = 0;
   };
   /// Adds a keyframe's points (in the submap's frame as `pose`) but for those an older keyframe holds.
   void insert(Submap* submap, const Pose2D& laser_pose, const std::vector<Eigen::Vector2d>& points);
-  /// True if a point of the submap lies within options_.resolution of `point`.
-  bool covered(const Submap& submap, const Eigen::Vector2d& point) const;
-  std::uint64_t cellKey(const Eigen::Vector2d& point, int dx, int dy) const;
   /// Points the de-duplication grid can hold (finite, within 1e6 m; wilder readings are never joined).
   static bool onGrid(const Eigen::Vector2d& point) {
     return std::abs(point.x()) <= 1e6 && std::abs(point.y()) <= 1e6;  // false for NaN
@@ -98,9 +116,10 @@ class LocalMap {
   std::uint64_t revision_ = 0;
   std::size_t unchanged_scans_ = 0;
   LookupTable empty_table_;
-  ReferencePoints added_;              // scratch: the keyframe's kept points as one scan
-  std::vector<Eigen::Vector2d> kept_;  // scratch: in the keyframe's frame
-  std::vector<std::uint8_t> covered_;  // scratch: per point of the keyframe, an older keyframe has it
+  ReferencePoints added_;               // scratch: the keyframe's kept points as one scan
+  std::vector<Eigen::Vector2d> kept_;   // scratch: in the keyframe's frame
+  std::vector<std::uint8_t> covered_;   // scratch: per point of the keyframe, an older keyframe has it
+  std::vector<Eigen::Vector2d> moved_;  // scratch: the keyframe's points in the submap's frame
 };
 
 }  // namespace hglasm

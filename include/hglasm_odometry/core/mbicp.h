@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "hglasm_odometry/core/pose2d.h"
@@ -206,7 +207,8 @@ class Mbicp {
   std::vector<int> sorted_index_;              // their indices into ref_points_
   std::vector<int> bucket_first_;  // first sorted index of each of n equal bearing buckets (n + 1 entries)
   std::vector<WalkEntry> walk_;    // the reference points in the order of sorted_bearing_
-  std::vector<Association> associations_;                       // scratch
+  std::vector<std::pair<double, int>> added_scratch_;  // mergeByBearing: the new points, bearing and index
+  std::vector<Association> associations_;              // scratch
   Eigen::Matrix3d scan_information_ = Eigen::Matrix3d::Zero();  // of the last step, increment coordinates
   ScanNoiseScale scan_noise_scale_ = ScanNoiseScale::Ones();
   std::vector<Eigen::Vector2d> moved_;   // scratch

@@ -11,7 +11,8 @@ namespace hglasm {
 struct SearchOptions {
   /// The GA searches this many standard deviations of the prediction on each axis, at least min_xy /
   /// min_theta and at most the preset's box, with the GA size of the smallest of the papers' presets whose
-  /// box holds that (never more than the configured preset's).
+  /// box holds that (never more than the configured preset's); a box within a third of the small preset's
+  /// on every axis with half its population and two thirds of its generations.
   double sigmas = 4.0;
   double min_xy = 0.10;     ///< metres
   double min_theta = 0.05;  ///< radians
