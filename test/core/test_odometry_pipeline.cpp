@@ -313,6 +313,7 @@ TEST(OdometryPipeline, SetPoseRestartsFromThePoseAndKeepsTheMount) {
 TEST(OdometryPipeline, ExposesTheLocalMapInTheOdometryFrameAndItsRevisionPerKeyframe) {
   TrackerOptions options;
   options.prediction.use_odometry = false;
+  options.keyframe.distance = 0.3;
   OdometryPipeline pipeline(options);
   const Pose2D mount(0.3, 0.1, 0.4);
   pipeline.setLaserMount(mount, false);

@@ -717,9 +717,10 @@ TEST(OdometryTracker, WithASweepingLaserTheGyroDeskewsTheSpins) {
   EXPECT_LT(5 * gyro.leaps, wheels.leaps);
   EXPECT_LT(gyro.translation_error, 0.02);
   EXPECT_LT(gyro.worst_rotation_error, hglasm_test::deg(1.0));
-  // At 5 Hz a sheared sweep may fit better elsewhere (its de-skewed beams still graze the walls): a leap or
-  // two is allowed when the pose stays within the bounds.
-  EXPECT_LE(slow.leaps, 2);
+  // At 5 Hz a sheared sweep may fit better elsewhere (its de-skewed beams still graze the walls): a few
+  // leaps (at most one step in twenty; the wheels alone leap at every spin) are allowed when the pose stays
+  // within the bounds.
+  EXPECT_LE(20 * slow.leaps, slow.scans);
   EXPECT_LT(slow.translation_error, 0.05);
   EXPECT_LT(slow.worst_rotation_error, hglasm_test::deg(3.0));
   EXPECT_NEAR(gyro.learned_bias, kGyroBias, 0.01);

@@ -9,7 +9,7 @@
 namespace hglasm {
 
 struct KeyframeOptions {
-  double distance = 0.30;    ///< metres moved since the keyframe that make a new keyframe
+  double distance = 0.50;    ///< metres moved since the keyframe that make a new keyframe
   double angle = 0.20;       ///< radians turned since the keyframe that make a new keyframe
   double min_fitness = 0.0;  ///< a published pose below this fitness ratio makes the scan a keyframe
 };
