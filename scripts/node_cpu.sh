@@ -13,6 +13,7 @@
 # worker: waiting, inputs, conversion, matching, publishing; scripts/node_cpu_monitor.py), with /tf and
 # /diagnostics the only subscriptions to the node's outputs. Process: every thread of the node's process,
 # per scan. Self: the node's own "CPU per scan, mean" (diagnostics; conversion, matching and publishing).
+# Wake: the worker's wake-ups (times scheduled in) per scan.
 # evaluate: its "total per scan (CPU)" (conversion and OdometryPipeline::processScan, one thread, as fast as
 # it goes). All in ms.
 # Run it niced on a shared machine: nice -n 10 scripts/node_cpu.sh ...
@@ -83,8 +84,8 @@ EOF
   tail -1 "$log"
 }
 
-printf "%-12s %5s %-2s | %-20s | %-20s | %-15s | %s\n" bag round d "evaluate mean/med/p99" \
-  "worker mean/med/p99" "process, self" "worker/evaluate mean median p99"
+printf "%-12s %5s %-2s | %-20s | %-20s | %-20s | %s\n" bag round d "evaluate mean/med/p99" \
+  "worker mean/med/p99" "process, self, wake" "worker/evaluate mean median p99"
 for bag in "${bags[@]}"; do
   name=$(basename "$bag" .bag)
   rows="$out_dir/${name}_rows.txt"
@@ -93,21 +94,22 @@ for bag in "${bags[@]}"; do
     evaluate=$(evaluate_cpu "$bag" "$out_dir/${name}_evaluate_$round.log")
     for d in "${!devels[@]}"; do
       line=$(node_cpu "${devels[$d]}" "$bag" "$out_dir/${name}_node${d}_$round.log")
-      worker=$(awk '{print $6, $8, $10, $12, $14}' <<<"$line")
+      worker=$(awk '{print $6, $8, $10, $12, $14, $16}' <<<"$line")
       echo "$d $evaluate $worker" >>"$rows"
-      # columns: d, evaluate mean median p99, worker mean median p99, process mean, the node's own mean
+      # columns: d, evaluate mean median p99, worker mean median p99, process mean, the node's own mean,
+      # the worker's wake-ups
     done
   done
   awk -v name="${name%_slice}" -v n="${#devels[@]}" '{
-      printf "%-12s %5d %-2s | %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f | %7.3f %7.3f | %5.2f %5.2f %5.2f\n", name,
-        int((NR - 1) / n) + 1, $1, $2, $3, $4, $5, $6, $7, $8, $9, $5 / $2, $6 / $3, $7 / $4
-      for (i = 2; i <= 9; ++i) sum[$1, i] += $i
+      printf "%-12s %5d %-2s | %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f | %6.3f %6.3f %5.2f | %5.2f %5.2f %5.2f\n",
+        name, int((NR - 1) / n) + 1, $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $5 / $2, $6 / $3, $7 / $4
+      for (i = 2; i <= 10; ++i) sum[$1, i] += $i
       seen[$1] = 1
     } END {
-      for (d = 0; d < n; ++d) printf "%-12s %5s %-2s | %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f | %7.3f %7.3f | %5.2f %5.2f %5.2f  (all rounds)\n",
+      for (d = 0; d < n; ++d) printf "%-12s %5s %-2s | %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f | %6.3f %6.3f %5.2f | %5.2f %5.2f %5.2f  (all rounds)\n",
         name, "all", d, sum[d, 2] * n / NR, sum[d, 3] * n / NR, sum[d, 4] * n / NR, sum[d, 5] * n / NR,
-        sum[d, 6] * n / NR, sum[d, 7] * n / NR, sum[d, 8] * n / NR, sum[d, 9] * n / NR, sum[d, 5] / sum[d, 2],
-        sum[d, 6] / sum[d, 3], sum[d, 7] / sum[d, 4]
+        sum[d, 6] * n / NR, sum[d, 7] * n / NR, sum[d, 8] * n / NR, sum[d, 9] * n / NR, sum[d, 10] * n / NR,
+        sum[d, 5] / sum[d, 2], sum[d, 6] / sum[d, 3], sum[d, 7] / sum[d, 4]
     }' "$rows"
 done
 echo "devels:"

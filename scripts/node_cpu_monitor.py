@@ -6,7 +6,8 @@ the standalone node) through the master, subscribes /tf (which a robot always ha
 odom -> base transform per scan processed) and, on each of the node's transforms, reads every thread's CPU
 time from /proc/PID/task/*/schedstat. The difference between two consecutive transforms is one whole cycle
 of the worker: waiting, taking the queued inputs, conversion, matching, publishing and bookkeeping. The
-worker is the thread that used the most CPU over the run. Prints one line of `key value` pairs.
+worker is the thread that used the most CPU over the run; its wake-ups are the times it was scheduled in.
+Prints one line of `key value` pairs.
 """
 import argparse
 import math
@@ -47,14 +48,15 @@ def loaded_library(pid, name, wait=30.0):
 
 
 def thread_cpu_ns(pid):
-    """{tid: nanoseconds on CPU} of every thread of `pid`."""
+    """{tid: (nanoseconds on CPU, times scheduled in)} of every thread of `pid`."""
     times = {}
     task_dir = "/proc/%d/task" % pid
     for tid in os.listdir(task_dir):
         try:
             with open("%s/%s/schedstat" % (task_dir, tid)) as f:
-                times[int(tid)] = int(f.read().split()[0])
-        except (OSError, ValueError):
+                fields = f.read().split()
+                times[int(tid)] = (int(fields[0]), int(fields[2]))
+        except (OSError, ValueError, IndexError):
             pass  # a thread that ended meanwhile
     return times
 
@@ -148,17 +150,18 @@ def main():
         sys.exit("node_cpu_monitor: only %d transforms from the node" % len(samples))
 
     first, last = samples[0], samples[-1]
-    totals = {tid: last[tid] - first.get(tid, 0) for tid in last}
+    totals = {tid: last[tid][0] - first.get(tid, (0, 0))[0] for tid in last}
     worker = max(totals, key=totals.get)
-    per_scan = sorted((b[worker] - a.get(worker, b[worker])) * 1e-6 for a, b in zip(samples, samples[1:]))
+    per_scan = sorted((b[worker][0] - a.get(worker, b[worker])[0]) * 1e-6 for a, b in zip(samples, samples[1:]))
     cycles = len(samples) - 1
+    wakeups = (last[worker][1] - first[worker][1]) / cycles
     process_ms = sum(totals.values()) * 1e-6 / cycles
     print("library %s" % library)
     with lock:
         node_mean = self_mean[0]
     print("transforms %d cycles %d worker_mean %.4f worker_median %.4f worker_p99 %.4f process_mean %.4f "
-          "self_mean %s" % (len(samples), cycles, sum(per_scan) / cycles, median(per_scan),
-                            percentile(per_scan, 0.99), process_ms, node_mean))
+          "self_mean %s worker_wakeups %.2f" % (len(samples), cycles, sum(per_scan) / cycles, median(per_scan),
+                                                percentile(per_scan, 0.99), process_ms, node_mean, wakeups))
 
 
 if __name__ == "__main__":
