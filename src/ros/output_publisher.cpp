@@ -1,5 +1,6 @@
 #include "hglasm_odometry/ros/output_publisher.h"
 
+#include <algorithm>
 #include <utility>
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
