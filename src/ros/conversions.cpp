@@ -76,16 +76,20 @@ void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
 
 hglasm::RangeScan rangeScanFromMsg(const sensor_msgs::LaserScan& msg) {
   hglasm::RangeScan scan;
-  scan.ranges = msg.ranges;
-  scan.angle_min = msg.angle_min;
-  scan.angle_increment = msg.angle_increment;
-  scan.time_increment = finiteOr(msg.time_increment, 0.0);
+  rangeScanFromMsg(msg, &scan);
+  return scan;
+}
+
+void rangeScanFromMsg(const sensor_msgs::LaserScan& msg, hglasm::RangeScan* scan) {
+  scan->ranges.assign(msg.ranges.begin(), msg.ranges.end());
+  scan->angle_min = msg.angle_min;
+  scan->angle_increment = msg.angle_increment;
+  scan->time_increment = finiteOr(msg.time_increment, 0.0);
   const double range_min = msg.range_min;
   const double range_max = msg.range_max;
-  scan.range_min = (std::isfinite(range_min) && range_min > 0.0) ? range_min : 0.0;
-  scan.range_max =
+  scan->range_min = (std::isfinite(range_min) && range_min > 0.0) ? range_min : 0.0;
+  scan->range_max =
       (std::isfinite(range_max) && range_max > 0.0) ? range_max : std::numeric_limits<double>::infinity();
-  return scan;
 }
 
 bool laserMountFromTransform(const geometry_msgs::Transform& transform, LaserMount* mount,
@@ -297,8 +301,12 @@ boost::array<double, 36> covariance6x6FromPlanar(const Eigen::Matrix3d& covarian
 }
 
 std::string stripLeadingSlash(const std::string& frame_id) {
+  return std::string(withoutLeadingSlash(frame_id));
+}
+
+std::string_view withoutLeadingSlash(std::string_view frame_id) {
   const auto first = frame_id.find_first_not_of('/');
-  return first == std::string::npos ? std::string() : frame_id.substr(first);
+  return first == std::string_view::npos ? std::string_view() : frame_id.substr(first);
 }
 
 float finiteFloat(double value) { return std::isfinite(value) ? static_cast<float>(value) : 0.0f; }

@@ -5,14 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <sstream>
+#include <utility>
 
-#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
-#include <nav_msgs/Path.h>
-#include <sensor_msgs/PointCloud2.h>
-#include <visualization_msgs/MarkerArray.h>
-
-#include "hglasm_odometry/Match.h"
 
 namespace hglasm_odometry {
 namespace {
@@ -24,6 +19,11 @@ double threadCpuMs() {
   return now.tv_sec * 1e3 + now.tv_nsec * 1e-6;
 }
 
+/// Seconds on the clock of the throttling, the mounts' retries and the diagnostics (monotonic).
+double steadySeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -32,11 +32,49 @@ double msSince(std::chrono::steady_clock::time_point start) {
 /// queue (callbacks are cheap); they are not where scans are dropped.
 constexpr int kScanSubscriberQueue = 50;
 constexpr int kOdomSubscriberQueue = 200;
-constexpr double kTfRetrySeconds = 0.05;  // wall time between tf lookups while waiting for base -> laser
-constexpr std::size_t kMaxQueuedOdometry = 10000;  // samples kept while the worker waits (100 s at 100 Hz)
 constexpr int kImuSubscriberQueue = 1000;
-constexpr std::size_t kMaxQueuedImu = 20000;  // 20 s at 1 kHz
-constexpr double kStaleWarnPeriod = 10.0;     // seconds between warnings about inputs stamped out of order
+constexpr double kTfRetrySeconds = 0.05;   // wall time between tf lookups while a mount is missing
+constexpr double kStaleWarnPeriod = 10.0;  // seconds between warnings about inputs stamped out of order
+
+InputQueueLimits queueLimits(const LaserOdometryOptions& options) {
+  InputQueueLimits limits;
+  limits.scans = static_cast<std::size_t>(options.queue_size);
+  return limits;
+}
+
+DiagnosticsSettings diagnosticsSettings(const LaserOdometryOptions& options) {
+  DiagnosticsSettings settings;
+  settings.thresholds = options.diagnostics;
+  settings.preset = options.preset;
+  settings.use_odometry = options.tracker.prediction.use_odometry;
+  settings.use_imu = options.tracker.prediction.use_imu;
+  settings.time_offset_learned = options.tracker.learning.odometry_time_offset.estimate;
+  return settings;
+}
+
+std::uint8_t statusLevel(DiagnosticsReport::Level level) {
+  switch (level) {
+    case DiagnosticsReport::Level::kOk:
+      return diagnostic_msgs::DiagnosticStatus::OK;
+    case DiagnosticsReport::Level::kWarn:
+      return diagnostic_msgs::DiagnosticStatus::WARN;
+    case DiagnosticsReport::Level::kError:
+      return diagnostic_msgs::DiagnosticStatus::ERROR;
+  }
+  return diagnostic_msgs::DiagnosticStatus::ERROR;
+}
+
+const char* predictionName(hglasm::PredictionSource source) {
+  switch (source) {
+    case hglasm::PredictionSource::kOdometry:
+      return "the wheel odometry";
+    case hglasm::PredictionSource::kConstantVelocity:
+      return "the recent motion";
+    case hglasm::PredictionSource::kNone:
+      return "nothing (no motion known yet)";
+  }
+  return "nothing (no motion known yet)";
+}
 
 }  // namespace
 
@@ -48,19 +86,15 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
       odom_topic_(nh.resolveName("odom")),
       nh_(nh),
       private_nh_(private_nh),
+      queue_(queueLimits(options)),
       pipeline_(options.tracker, options.odometry_wait > 0.0),
+      laser_mount_(0.0, 1),
+      imu_mounts_(kTfRetrySeconds),
+      output_(private_nh_, options, [this] { queue_.requestLocalMap(); }),
+      diagnostics_settings_(diagnosticsSettings(options)),
       tf_listener_(tf_buffer_),
       diagnostics_(nh, private_nh, private_nh.getNamespace()) {
-  // Outputs first, inputs last: nothing arrives before there is somewhere to publish it.
-  odom_pub_ = private_nh_.advertise<nav_msgs::Odometry>("odom", 50);
-  pose_pub_ = private_nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose", 50);
-  if (options_.path_length > 0) path_pub_ = private_nh_.advertise<nav_msgs::Path>("path", 2);
-  match_pub_ = private_nh_.advertise<Match>("match", 50);
-  if (options_.publish_population) {
-    population_pub_ = private_nh_.advertise<visualization_msgs::MarkerArray>("ga_population", 2);
-  }
-  local_map_pub_ = private_nh_.advertise<sensor_msgs::PointCloud2>(
-      "local_map", 2, [this](const ros::SingleSubscriberPublisher&) { local_map_resend_ = true; });
+  // Outputs first (output_), inputs last: nothing arrives before there is somewhere to publish it.
   reset_service_ = private_nh_.advertiseService("reset", &LaserOdometry::resetCallback, this);
   set_pose_service_ = private_nh_.advertiseService("set_pose", &LaserOdometry::setPoseCallback, this);
 
@@ -71,7 +105,10 @@ LaserOdometry::LaserOdometry(const ros::NodeHandle& nh, const ros::NodeHandle& p
                                   [this](const ros::WallTimerEvent&) { diagnostics_.force_update(); });
 
   worker_ = std::thread(&LaserOdometry::workerLoop, this);
+  subscribe();
+}
 
+void LaserOdometry::subscribe() {
   scan_sub_ = nh_.subscribe("scan", kScanSubscriberQueue, &LaserOdometry::scanCallback, this,
                             ros::TransportHints().tcpNoDelay());
   if (options_.tracker.prediction.use_odometry) {
@@ -102,109 +139,18 @@ LaserOdometry::~LaserOdometry() {
   reset_service_.shutdown();
   set_pose_service_.shutdown();
   diagnostics_timer_.stop();
-  {
-    std::lock_guard<std::mutex> lock(input_mutex_);
-    stop_ = true;
-  }
-  input_cv_.notify_all();
+  queue_.stop();
   if (worker_.joinable()) worker_.join();
 }
 
+// ------------------------------------------------------------------------------------------ spinner threads
+
 void LaserOdometry::scanCallback(const sensor_msgs::LaserScanConstPtr& msg) {
-  {
-    std::lock_guard<std::mutex> lock(input_mutex_);
-    if (scans_.size() >= static_cast<std::size_t>(options_.queue_size)) {
-      scans_.pop_front();  // the oldest scan is the least useful one to a live estimate
-      ++dropped_scans_;
-    }
-    scans_.push_back(msg);
-  }
-  input_cv_.notify_all();
-  std::lock_guard<std::mutex> lock(stats_mutex_);
-  ++scans_received_;
-  last_scan_time_ = ros::WallTime::now();
-}
-
-void LaserOdometry::odomCallback(const nav_msgs::OdometryConstPtr& msg) {
-  OdometrySample sample;
-  if (!pose2DFromOdometryMsg(*msg, &sample.pose)) {
-    warnThrottled("odom_nan", "wheel odometry message with a non-finite pose ignored", 10.0);
-    return;
-  }
-  sample.stamp = msg->header.stamp.toSec();
-  sample.child_frame = stripLeadingSlash(msg->child_frame_id);
-  {
-    std::lock_guard<std::mutex> lock(input_mutex_);
-    // The worker takes the samples before every scan; this bound only matters while it waits for tf.
-    if (odometry_.size() >= kMaxQueuedOdometry) odometry_.pop_front();
-    odometry_.push_back(std::move(sample));
-  }
-  input_cv_.notify_all();
-}
-
-void LaserOdometry::imuCallback(const sensor_msgs::ImuConstPtr& msg) {
-  // Converted here, outside the worker's lock: a tf lookup per message must not hold up the other inputs.
-  ImuSample sample;
-  if (!imuValueInBase(*msg, &sample.value)) return;
-  sample.stamp = msg->header.stamp.toSec();
-  {
-    std::lock_guard<std::mutex> lock(input_mutex_);
-    if (imu_.size() >= kMaxQueuedImu) imu_.pop_front();
-    imu_.push_back(sample);
-  }
-  input_cv_.notify_all();
-}
-
-bool LaserOdometry::imuValueInBase(const sensor_msgs::Imu& msg, double* value) {
-  geometry_msgs::Quaternion mount;
-  if (!imuMount(stripLeadingSlash(msg.header.frame_id), &mount)) return false;
-  std::string error;
-  if (!imuValueFromMsg(msg, mount, options_.tracker.prediction.imu.use_orientation, value, &error)) {
-    warnThrottled("imu_bad", "IMU sample on " + imu_topic_ + " ignored: " + error, 10.0);
-    return false;
-  }
-  return true;
-}
-
-bool LaserOdometry::imuMount(const std::string& frame, geometry_msgs::Quaternion* rotation) {
-  std::lock_guard<std::mutex> lock(imu_mount_mutex_);
-  const auto known = imu_mounts_.find(frame);
-  if (known != imu_mounts_.end()) {
-    *rotation = known->second;
-    return true;
-  }
-  geometry_msgs::Quaternion found;
-  found.w = 1.0;
-  if (frame.empty() && !warned_imu_frame_) {
-    warned_imu_frame_ = true;
-    ROS_WARN_STREAM("[" << name_ << "] IMU messages on " << imu_topic_
-                        << " carry no frame_id; assuming the IMU is aligned with " << options_.base_frame);
-  } else if (!frame.empty() && frame != options_.base_frame) {
-    const ros::WallTime now = ros::WallTime::now();
-    if (now < imu_tf_retry_) return false;
-    try {
-      found = tf_buffer_.lookupTransform(options_.base_frame, frame, ros::Time(0)).transform.rotation;
-    } catch (const tf2::TransformException& ex) {
-      imu_tf_retry_ = now + ros::WallDuration(kTfRetrySeconds);
-      warnThrottled("imu_tf",
-                    "IMU samples dropped: no transform " + options_.base_frame + " -> " + frame +
-                        " (base_frame -> the IMU's frame_id) on tf yet (" + ex.what() + ")",
-                    options_.tf_warn_period);
-      return false;
-    }
-  }
-  imu_mounts_.emplace(frame, found);
-  *rotation = found;
-  return true;
+  queue_.pushScan(msg, steadySeconds());
 }
 
 bool LaserOdometry::resetCallback(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-  {
-    std::lock_guard<std::mutex> lock(input_mutex_);
-    reset_requested_ = true;
-    pose_requested_.reset();
-  }
-  input_cv_.notify_all();
+  queue_.requestReset();
   ROS_INFO_STREAM("[" << name_ << "] reset requested: restarting from the origin at the next scan");
   return true;
 }
@@ -224,12 +170,7 @@ bool LaserOdometry::requestPose(const geometry_msgs::PoseWithCovarianceStamped& 
     text << " (its covariance is not a valid x, y, yaw covariance: zero used, the pose taken as exact)";
   }
   *message = text.str();
-  {
-    std::lock_guard<std::mutex> lock(input_mutex_);
-    pose_requested_ = request;
-    reset_requested_ = false;
-  }
-  input_cv_.notify_all();
+  queue_.requestPose(request);
   return true;
 }
 
@@ -252,30 +193,228 @@ void LaserOdometry::setPoseTopicCallback(const geometry_msgs::PoseWithCovariance
   }
 }
 
-void LaserOdometry::takeQueuedInputs() {
-  if (reset_requested_) {
-    pipeline_.reset();
-    reset_requested_ = false;
+void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const ScanQueueCounts scans = queue_.scanCounts();
+  DiagnosticsReport report;
+  {
+    std::lock_guard<std::mutex> lock(statistics_mutex_);
+    report = hglasm_odometry::diagnose(statistics_, scans, diagnostics_settings_, steadySeconds(),
+                                       last_reported_drops_);
   }
-  if (pose_requested_) {
-    if (!pipeline_.setPose(pose_requested_->stamp, pose_requested_->pose, pose_requested_->covariance)) {
-      ROS_WARN_STREAM("[" << name_ << "] the pose to continue from was refused by the tracker");
+  last_reported_drops_ = scans.dropped;
+  for (const auto& [key, value] : report.values) status.add(key, value);
+  status.summary(statusLevel(report.level), report.summary);
+}
+
+// ------------------------------------------------------------------------------------------ the worker
+
+void LaserOdometry::workerLoop() {
+  while (std::optional<sensor_msgs::LaserScanConstPtr> scan = queue_.waitForScan()) {
+    const sensor_msgs::LaserScan& msg = **scan;
+    if (!laserMountReady(msg.header.frame_id)) {
+      // Held at the front (dropped instead if the queue filled up meanwhile) and retried shortly.
+      if (!queue_.holdScan(std::move(*scan), kTfRetrySeconds)) return;
+      continue;
     }
-    pose_requested_.reset();
+    const double sweep = hglasm::scanSweepTime(msg.time_increment, msg.ranges.size(), pipeline_.conversion());
+    if (!waitForInputs(msg.header.stamp.toSec(), sweep)) return;
+    processScan(msg);
   }
-  for (const OdometrySample& sample : odometry_) {
-    if (!sample.child_frame.empty() && sample.child_frame != options_.base_frame &&
-        !warned_odom_child_frame_) {
-      warned_odom_child_frame_ = true;  // once: the configuration will not change by itself
-      ROS_WARN_STREAM("[" << name_ << "] wheel odometry on " << odom_topic_ << " is of frame \""
-                          << sample.child_frame << "\", not of base_frame \"" << options_.base_frame
-                          << "\"; it is used as the motion of base_frame anyway");
+}
+
+bool LaserOdometry::waitForInputs(double stamp, double sweep) {
+  // Wheels whose stamps run late are waited for that much longer: their pose of the scan's instant comes
+  // with a later message.
+  const double wait = options_.odometry_wait + std::max(0.0, pipeline_.odometryTimeOffset());
+  const auto deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wait));
+  while (takeInputs()) {
+    if (pipeline_.inputsReadyFor(stamp, sweep)) return true;
+    if (!queue_.waitForInputs(deadline)) {
+      if (!takeInputs()) return false;
+      // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
+      pipeline_.inputsWaitTimedOut(stamp, sweep);
+      return true;
     }
-    reportSample(false, pipeline_.addOdometry(sample.stamp, sample.pose));
   }
-  odometry_.clear();
-  for (const ImuSample& sample : imu_) reportSample(true, pipeline_.addImu(sample.stamp, sample.value));
-  imu_.clear();
+  return false;
+}
+
+bool LaserOdometry::takeInputs() {
+  const bool running = queue_.take(&inputs_);
+  if (inputs_.reset) pipeline_.reset();
+  if (inputs_.pose && !pipeline_.setPose(inputs_.pose->stamp, inputs_.pose->pose, inputs_.pose->covariance)) {
+    ROS_WARN_STREAM("[" << name_ << "] the pose to continue from was refused by the tracker");
+  }
+  for (std::size_t i = 0; i < inputs_.odometry.size(); ++i) addOdometry(*inputs_.odometry[i]);
+  inputs_.odometry.clear();
+  for (std::size_t i = 0; i < inputs_.imu.size(); ++i) addImu(*inputs_.imu[i]);
+  inputs_.imu.clear();
+  return running;
+}
+
+void LaserOdometry::addOdometry(const nav_msgs::Odometry& msg) {
+  hglasm::Pose2D pose;
+  if (!pose2DFromOdometryMsg(msg, &pose)) {
+    warnThrottled("odom_nan", "wheel odometry message with a non-finite pose ignored", 10.0);
+    return;
+  }
+  const std::string_view child_frame = withoutLeadingSlash(msg.child_frame_id);
+  if (!child_frame.empty() && child_frame != options_.base_frame && !warned_odom_child_frame_) {
+    warned_odom_child_frame_ = true;  // once: the configuration will not change by itself
+    ROS_WARN_STREAM("[" << name_ << "] wheel odometry on " << odom_topic_ << " is of frame \"" << child_frame
+                        << "\", not of base_frame \"" << options_.base_frame
+                        << "\"; it is used as the motion of base_frame anyway");
+  }
+  reportSample(false, pipeline_.addOdometry(msg.header.stamp.toSec(), pose));
+}
+
+void LaserOdometry::addImu(const sensor_msgs::Imu& msg) {
+  geometry_msgs::Quaternion mount;
+  if (!imuMount(withoutLeadingSlash(msg.header.frame_id), &mount)) return;
+  double value = 0.0;
+  std::string error;
+  if (!imuValueFromMsg(msg, mount, options_.tracker.prediction.imu.use_orientation, &value, &error)) {
+    warnThrottled("imu_bad", "IMU sample on " + imu_topic_ + " ignored: " + error, 10.0);
+    return;
+  }
+  reportSample(true, pipeline_.addImu(msg.header.stamp.toSec(), value));
+}
+
+bool LaserOdometry::imuMount(std::string_view frame, geometry_msgs::Quaternion* rotation) {
+  if (frame.empty() || frame == options_.base_frame) {
+    if (frame.empty() && !warned_imu_frame_) {
+      warned_imu_frame_ = true;
+      ROS_WARN_STREAM("[" << name_ << "] IMU messages on " << imu_topic_
+                          << " carry no frame_id; assuming the IMU is aligned with " << options_.base_frame);
+    }
+    *rotation = geometry_msgs::Quaternion();
+    rotation->w = 1.0;
+    return true;
+  }
+  const auto lookup = [this](std::string_view imu_frame, geometry_msgs::Quaternion* found) {
+    const std::string frame_id(imu_frame);
+    try {
+      *found = tf_buffer_.lookupTransform(options_.base_frame, frame_id, ros::Time(0)).transform.rotation;
+      return true;
+    } catch (const tf2::TransformException& ex) {
+      warnThrottled("imu_tf",
+                    "IMU samples dropped: no transform " + options_.base_frame + " -> " + frame_id +
+                        " (base_frame -> the IMU's frame_id) on tf yet (" + ex.what() + ")",
+                    options_.tf_warn_period);
+      return false;
+    }
+  };
+  return imu_mounts_.find(frame, steadySeconds(), lookup, rotation) !=
+         decltype(imu_mounts_)::Result::kMissing;
+}
+
+bool LaserOdometry::laserMountReady(const std::string& frame_id) {
+  const std::string_view frame = withoutLeadingSlash(frame_id);
+  LaserMount mount;
+  const auto lookup = [this](std::string_view laser_frame, LaserMount* found) {
+    return lookupLaserMount(laser_frame, found);
+  };
+  switch (laser_mount_.find(frame, steadySeconds(), lookup, &mount)) {
+    case MountCache<LaserMount>::Result::kCached:
+      return true;
+    case MountCache<LaserMount>::Result::kFound:
+      useLaserMount(frame, mount);
+      return true;
+    case MountCache<LaserMount>::Result::kMissing:
+      return false;
+  }
+  return false;
+}
+
+bool LaserOdometry::lookupLaserMount(std::string_view frame, LaserMount* mount) {
+  *mount = LaserMount();
+  if (frame.empty() || frame == options_.base_frame) {
+    // The scans are in the base frame (or say nothing): no tf needed.
+    if (frame.empty()) {
+      ROS_WARN_STREAM("[" << name_ << "] scans carry no frame_id; assuming the laser is at the origin of "
+                          << options_.base_frame);
+    }
+    return true;
+  }
+  const std::string laser_frame(frame);
+  geometry_msgs::TransformStamped transform;
+  try {
+    transform = tf_buffer_.lookupTransform(options_.base_frame, laser_frame, ros::Time(0));
+  } catch (const tf2::TransformException& ex) {
+    std::ostringstream text;
+    text << "waiting for the transform " << options_.base_frame << " -> " << laser_frame
+         << " (base_frame -> scan frame_id) on tf/tf_static; scans are held until it appears (" << ex.what()
+         << ")";
+    setTfWait("waiting for tf " + options_.base_frame + " -> " + laser_frame);
+    warnThrottled("tf_wait", text.str(), options_.tf_warn_period);
+    return false;
+  }
+  std::string error;
+  if (!laserMountFromTransform(transform.transform, mount, &error)) {
+    warnThrottled("tf_bad", "unusable transform " + options_.base_frame + " -> " + laser_frame + ": " + error,
+                  options_.tf_warn_period);
+    setTfWait("unusable tf " + options_.base_frame + " -> " + laser_frame);
+    return false;
+  }
+  return true;
+}
+
+void LaserOdometry::useLaserMount(std::string_view frame, const LaserMount& mount) {
+  setTfWait(std::nullopt);
+  pipeline_.setLaserMount(mount.base_to_laser, mount.upside_down);
+  ROS_INFO_STREAM("[" << name_ << "] scan frame \"" << frame << "\" at x " << mount.base_to_laser.x
+                      << " m, y " << mount.base_to_laser.y << " m, yaw " << mount.base_to_laser.theta
+                      << " rad in \"" << options_.base_frame << "\""
+                      << (mount.upside_down ? ", upside down (scans mirrored)" : ""));
+  if (mount.tilt > 0.05) {
+    ROS_WARN_STREAM("[" << name_ << "] the laser's scan plane is tilted by " << mount.tilt
+                        << " rad from the base plane; its planar projection is approximate");
+  }
+}
+
+void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = threadCpuMs();
+  const bool with_population = output_.populationWanted();
+  rangeScanFromMsg(msg, &ranges_);
+  const hglasm::PipelineUpdate result =
+      pipeline_.processScan(msg.header.stamp.toSec(), ranges_, with_population ? &population_ : nullptr);
+  reportScan(result);
+  publish(msg.header, result, with_population, msSince(start));
+  recordScan(result.tracker, threadCpuMs() - cpu_start);
+}
+
+void LaserOdometry::publish(const std_msgs::Header& scan, const hglasm::PipelineUpdate& result,
+                            bool with_population, double total_ms) {
+  const hglasm::TrackerUpdate& update = result.tracker;
+  if (update.reset) output_.restartPath();
+  if (update.published) output_.publishEstimate(scan.stamp, update);
+  if (output_.matchWanted()) output_.publishMatch(scan, result, total_ms, queue_.droppedScans());
+  if (with_population && update.matched) output_.publishPopulation(scan.stamp, update, population_);
+  if (output_.localMapWanted()) {
+    output_.publishLocalMap(scan.stamp, pipeline_.localMap(), queue_.takeLocalMapRequest());
+  }
+}
+
+void LaserOdometry::reportScan(const hglasm::PipelineUpdate& result) {
+  if (result.scan_error_changed) {
+    // One message per change of state, not per scan.
+    if (result.scan_error != hglasm::ScanError::kNone) {
+      ROS_WARN_STREAM("[" << name_ << "] unusable scan (" << hglasm::toString(result.scan_error)
+                          << "); integrating the prediction until scans are valid again");
+    } else {
+      ROS_INFO_STREAM("[" << name_ << "] scans are valid again");
+    }
+  }
+  const hglasm::TrackerUpdate& update = result.tracker;
+  if (update.stale) {
+    warnThrottled("stale scan", update.warning + " (counted in diagnostics)", kStaleWarnPeriod);
+  } else if (!update.warning.empty()) {
+    ROS_WARN_STREAM("[" << name_ << "] " << update.warning);
+  }
+  reportImuState(result);
 }
 
 void LaserOdometry::reportSample(bool imu, hglasm::SampleVerdict verdict) {
@@ -296,350 +435,35 @@ void LaserOdometry::reportSample(bool imu, hglasm::SampleVerdict verdict) {
 void LaserOdometry::reportImuState(const hglasm::PipelineUpdate& update) {
   if (!update.imu_stale_changed) return;
   if (update.imu_stale) {
-    std::ostringstream text;
-    text << "no IMU data on " << imu_topic_ << " covers the step to the scan at " << update.tracker.stamp
-         << " s (missing, or a gap longer than imu/max_gap " << options_.tracker.prediction.imu.max_gap
-         << " s); the rotation is predicted from "
-         << (update.tracker.diagnostics.prediction == hglasm::PredictionSource::kOdometry
-                 ? "the wheel odometry"
-             : update.tracker.diagnostics.prediction == hglasm::PredictionSource::kConstantVelocity
-                 ? "the recent motion"
-                 : "nothing (no motion known yet)")
-         << " until it returns";
-    ROS_WARN_STREAM("[" << name_ << "] " << text.str());
+    ROS_WARN_STREAM("[" << name_ << "] no IMU data on " << imu_topic_ << " covers the step to the scan at "
+                        << update.tracker.stamp << " s (missing, or a gap longer than imu/max_gap "
+                        << options_.tracker.prediction.imu.max_gap << " s); the rotation is predicted from "
+                        << predictionName(update.tracker.diagnostics.prediction) << " until it returns");
   } else {
     ROS_INFO_STREAM("[" << name_ << "] IMU data on " << imu_topic_ << " again: the rotation is the IMU's");
   }
-  std::lock_guard<std::mutex> lock(stats_mutex_);
-  imu_stale_ = update.imu_stale;
+  std::lock_guard<std::mutex> lock(statistics_mutex_);
+  statistics_.imu_stale = update.imu_stale;
 }
 
-bool LaserOdometry::waitForInputs(double stamp, double sweep) {
-  // Wheels whose stamps run late are waited for that much longer: their pose of the scan's instant comes
-  // with a later message.
-  const double wait = options_.odometry_wait + std::max(0.0, pipeline_.odometryTimeOffset());
-  const auto deadline =
-      std::chrono::steady_clock::now() +
-      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wait));
-  std::unique_lock<std::mutex> lock(input_mutex_);
-  while (true) {
-    takeQueuedInputs();
-    if (stop_) return false;
-    if (pipeline_.inputsReadyFor(stamp, sweep)) return true;
-    if (input_cv_.wait_until(lock, deadline) == std::cv_status::timeout) {
-      takeQueuedInputs();
-      // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
-      pipeline_.inputsWaitTimedOut(stamp, sweep);
-      return !stop_;
-    }
-  }
+void LaserOdometry::recordScan(const hglasm::TrackerUpdate& update, double cpu_ms) {
+  ScanRecord record;
+  record.time = steadySeconds();
+  record.cpu_ms = cpu_ms;
+  record.matched = update.matched;
+  record.fallback = update.fallback;
+  const hglasm::InputCounts counts = pipeline_.inputCounts();
+  std::lock_guard<std::mutex> lock(statistics_mutex_);
+  statistics_.add(record, update, counts, options_.diagnostics.window);
+}
+
+void LaserOdometry::setTfWait(std::optional<std::string> text) {
+  std::lock_guard<std::mutex> lock(statistics_mutex_);
+  statistics_.tf_wait = std::move(text);
 }
 
 void LaserOdometry::warnThrottled(const std::string& key, const std::string& text, double period) {
-  const ros::WallTime now = ros::WallTime::now();
-  {
-    std::lock_guard<std::mutex> lock(log_mutex_);
-    auto it = last_warning_.find(key);
-    if (it != last_warning_.end() && (now - it->second).toSec() < period) return;
-    last_warning_[key] = now;
-  }
-  ROS_WARN_STREAM("[" << name_ << "] " << text);
-}
-
-bool LaserOdometry::ensureLaserMount(const std::string& laser_frame) {
-  if (have_mount_ && laser_frame == mount_frame_) return true;
-  LaserMount mount;
-  if (laser_frame.empty() || laser_frame == options_.base_frame) {
-    // The scans are in the base frame (or say nothing): no tf needed.
-    if (laser_frame.empty()) {
-      ROS_WARN_STREAM("[" << name_ << "] scans carry no frame_id; assuming the laser is at the origin of "
-                          << options_.base_frame);
-    }
-  } else {
-    geometry_msgs::TransformStamped transform;
-    try {
-      transform = tf_buffer_.lookupTransform(options_.base_frame, laser_frame, ros::Time(0));
-    } catch (const tf2::TransformException& ex) {
-      std::ostringstream text;
-      text << "waiting for the transform " << options_.base_frame << " -> " << laser_frame
-           << " (base_frame -> scan frame_id) on tf/tf_static; scans are held until it appears (" << ex.what()
-           << ")";
-      {
-        std::lock_guard<std::mutex> lock(stats_mutex_);
-        tf_wait_text_ = "waiting for tf " + options_.base_frame + " -> " + laser_frame;
-        waiting_for_tf_ = true;
-      }
-      warnThrottled("tf_wait", text.str(), options_.tf_warn_period);
-      return false;
-    }
-    std::string error;
-    if (!laserMountFromTransform(transform.transform, &mount, &error)) {
-      warnThrottled("tf_bad",
-                    "unusable transform " + options_.base_frame + " -> " + laser_frame + ": " + error,
-                    options_.tf_warn_period);
-      std::lock_guard<std::mutex> lock(stats_mutex_);
-      tf_wait_text_ = "unusable tf " + options_.base_frame + " -> " + laser_frame;
-      waiting_for_tf_ = true;
-      return false;
-    }
-  }
-  {
-    std::lock_guard<std::mutex> lock(stats_mutex_);
-    waiting_for_tf_ = false;
-  }
-  have_mount_ = true;
-  mount_frame_ = laser_frame;
-  pipeline_.setLaserMount(mount.base_to_laser, mount.upside_down);
-  ROS_INFO_STREAM("[" << name_ << "] scan frame \"" << laser_frame << "\" at x " << mount.base_to_laser.x
-                      << " m, y " << mount.base_to_laser.y << " m, yaw " << mount.base_to_laser.theta
-                      << " rad in \"" << options_.base_frame << "\""
-                      << (mount.upside_down ? ", upside down (scans mirrored)" : ""));
-  if (mount.tilt > 0.05) {
-    ROS_WARN_STREAM("[" << name_ << "] the laser's scan plane is tilted by " << mount.tilt
-                        << " rad from the base plane; its planar projection is approximate");
-  }
-  return true;
-}
-
-void LaserOdometry::workerLoop() {
-  while (true) {
-    sensor_msgs::LaserScanConstPtr msg;
-    {
-      std::unique_lock<std::mutex> lock(input_mutex_);
-      input_cv_.wait(lock, [this] { return stop_ || !scans_.empty(); });
-      if (stop_) return;
-      msg = scans_.front();
-      scans_.pop_front();
-    }
-    if (!ensureLaserMount(stripLeadingSlash(msg->header.frame_id))) {
-      // Hold the scan (at the front, unless the queue filled up meanwhile: then it is the oldest and
-      // is dropped) and retry shortly.
-      std::unique_lock<std::mutex> lock(input_mutex_);
-      if (scans_.size() < static_cast<std::size_t>(options_.queue_size)) {
-        scans_.push_front(msg);
-      } else {
-        ++dropped_scans_;
-      }
-      input_cv_.wait_for(lock, std::chrono::duration<double>(kTfRetrySeconds), [this] { return stop_; });
-      if (stop_) return;
-      continue;
-    }
-    const double sweep =
-        hglasm::scanSweepTime(msg->time_increment, msg->ranges.size(), pipeline_.conversion());
-    if (!waitForInputs(msg->header.stamp.toSec(), sweep)) return;
-    processScan(*msg);
-  }
-}
-
-void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
-  const double stamp = msg.header.stamp.toSec();
-  const auto start = std::chrono::steady_clock::now();
-  const double cpu_start = threadCpuMs();
-
-  std::vector<hglasm::Pose2D> population;
-  const bool want_population = options_.publish_population && population_pub_.getNumSubscribers() > 0;
-  const hglasm::RangeScan ranges = rangeScanFromMsg(msg);
-  const hglasm::PipelineUpdate result =
-      pipeline_.processScan(stamp, ranges, want_population ? &population : nullptr);
-  const hglasm::TrackerUpdate& update = result.tracker;
-  if (result.scan_error_changed) {
-    // One message per change of state, not per scan.
-    if (result.scan_error != hglasm::ScanError::kNone) {
-      ROS_WARN_STREAM("[" << name_ << "] unusable scan (" << hglasm::toString(result.scan_error)
-                          << "); integrating the prediction until scans are valid again");
-    } else {
-      ROS_INFO_STREAM("[" << name_ << "] scans are valid again");
-    }
-  }
-  if (update.stale) {
-    warnThrottled("stale scan", update.warning + " (counted in diagnostics)", kStaleWarnPeriod);
-  } else if (!update.warning.empty()) {
-    ROS_WARN_STREAM("[" << name_ << "] " << update.warning);
-  }
-  reportImuState(result);
-  if (update.reset) path_.clear();
-
-  publish(msg, result, msSince(start));
-  if (want_population && update.matched) publishPopulation(msg.header.stamp, update, population);
-  publishLocalMap(msg.header.stamp);
-
-  ScanRecord record;
-  record.time = ros::WallTime::now();
-  record.cpu_ms = threadCpuMs() - cpu_start;
-  record.matched = update.matched;
-  record.fallback = update.fallback;
-  std::lock_guard<std::mutex> lock(stats_mutex_);
-  input_counts_ = pipeline_.inputCounts();
-  time_offset_ = update.diagnostics.odometry_time_offset;
-  time_offset_estimate_ = update.diagnostics.odometry_time_offset_estimate;
-  if (update.matched) {
-    degeneracy_ = update.diagnostics.degeneracy;
-    weakest_direction_ = update.diagnostics.weakest_direction;
-  }
-  noise_scale_ = update.diagnostics.learned.wheel_noise;
-  if (update.stale) return;  // not processed: not a scan of the rate or failure statistics
-  ++scans_processed_;
-  if (update.fallback) ++fallbacks_;
-  if (update.reset) ++resets_;
-  records_.push_back(record);
-  while (!records_.empty() && (record.time - records_.front().time).toSec() > options_.diagnostics.window) {
-    records_.pop_front();
-  }
-}
-
-void LaserOdometry::publish(const sensor_msgs::LaserScan& msg, const hglasm::PipelineUpdate& result,
-                            double total_ms) {
-  if (result.tracker.published) publishPose(msg.header.stamp, result.tracker);
-  std::uint32_t dropped_scans = 0;
-  {
-    std::lock_guard<std::mutex> lock(input_mutex_);
-    dropped_scans = dropped_scans_;
-  }
-  match_pub_.publish(matchMsgFromUpdate(result, msg.header, total_ms, dropped_scans));
-}
-
-void LaserOdometry::publishPose(const ros::Time& stamp, const hglasm::TrackerUpdate& update) {
-  std_msgs::Header header;
-  header.stamp = stamp;
-  header.frame_id = options_.odom_frame;
-  const nav_msgs::Odometry odom = odometryMsgFromUpdate(update, header, options_.base_frame);
-  odom_pub_.publish(odom);
-
-  geometry_msgs::PoseWithCovarianceStamped pose_msg;
-  pose_msg.header = header;
-  pose_msg.pose = odom.pose;
-  pose_pub_.publish(pose_msg);
-
-  if (options_.publish_tf) {
-    geometry_msgs::TransformStamped transform;
-    transform.header = header;
-    transform.child_frame_id = options_.base_frame;
-    transform.transform = transformMsgFromPose2D(update.pose);
-    tf_broadcaster_.sendTransform(transform);
-  }
-
-  if (options_.path_length > 0) {
-    geometry_msgs::PoseStamped path_pose;
-    path_pose.header = header;
-    path_pose.pose = odom.pose.pose;
-    path_.push_back(path_pose);
-    while (path_.size() > static_cast<std::size_t>(options_.path_length)) path_.pop_front();
-    if (path_pub_.getNumSubscribers() > 0) {
-      nav_msgs::Path path;
-      path.header = header;
-      path.poses.assign(path_.begin(), path_.end());
-      path_pub_.publish(path);
-    }
-  }
-}
-
-void LaserOdometry::publishLocalMap(const ros::Time& stamp) {
-  if (local_map_pub_.getNumSubscribers() == 0) return;  // nothing is built for nobody
-  const hglasm::LocalMap& map = pipeline_.localMap();
-  const bool resend = local_map_resend_.exchange(false);
-  if (!resend && local_map_sent_ && map.revision() == local_map_revision_) return;
-  std_msgs::Header header;
-  header.stamp = stamp;
-  header.frame_id = options_.odom_frame;
-  local_map_pub_.publish(pointCloudMsgFromPoints(header, map.frame(), map.reference().points));
-  local_map_sent_ = true;
-  local_map_revision_ = map.revision();
-}
-
-void LaserOdometry::publishPopulation(const ros::Time& stamp, const hglasm::TrackerUpdate& update,
-                                      const std::vector<hglasm::Pose2D>& population) {
-  std_msgs::Header header;
-  header.stamp = stamp;
-  header.frame_id = options_.odom_frame;
-  population_pub_.publish(populationMarkers(header, population, update.pose, update.diagnostics.guess));
-}
-
-void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  const ros::WallTime now = ros::WallTime::now();
-  std::size_t queued = 0;
-  std::uint32_t dropped_total = 0;
-  {
-    std::lock_guard<std::mutex> lock(input_mutex_);
-    queued = scans_.size();
-    dropped_total = dropped_scans_;
-  }
-  std::lock_guard<std::mutex> lock(stats_mutex_);
-  while (!records_.empty() && (now - records_.front().time).toSec() > options_.diagnostics.window) {
-    records_.pop_front();
-  }
-  const std::size_t count = records_.size();
-  double cpu_sum = 0.0, cpu_max = 0.0;
-  // Every scan that should have given a laser estimate counts: a failed match, but also an empty or
-  // all-invalid scan (a blinded or disconnected laser), whose motion came from the prediction alone.
-  std::size_t matched = 0, failed = 0;
-  for (const ScanRecord& record : records_) {
-    cpu_sum += record.cpu_ms;
-    cpu_max = std::max(cpu_max, record.cpu_ms);
-    if (record.matched || record.fallback) ++matched;
-    if (record.fallback) ++failed;
-  }
-  // Processing rate over the records in the window (wall clock: what the robot's computer sustains).
-  const double span = count >= 2 ? (records_.back().time - records_.front().time).toSec() : 0.0;
-  const double rate = span > 0.0 ? (count - 1) / span : 0.0;
-  const double cpu_mean = count > 0 ? cpu_sum / count : 0.0;
-  const double failure_ratio = matched > 0 ? static_cast<double>(failed) / matched : 0.0;
-
-  status.add("scan rate (Hz)", rate);
-  status.add("CPU per scan, mean (ms)", cpu_mean);
-  status.add("CPU per scan, max (ms)", cpu_max);
-  status.add("failure ratio", failure_ratio);
-  status.add("scans received", scans_received_);
-  status.add("scans processed", scans_processed_);
-  status.add("fallbacks", fallbacks_);
-  status.add("resets", resets_);
-  status.add("clock jumps back (resets)", input_counts_.jumps_back);
-  status.add("dropped scans", dropped_total);
-  status.add("stale scans dropped", input_counts_.stale_scans);
-  status.add("stale odometry samples dropped", input_counts_.stale_odometry);
-  if (options_.tracker.prediction.use_imu) status.add("stale IMU samples dropped", input_counts_.stale_imu);
-  if (options_.tracker.prediction.use_odometry) {
-    status.add("odometry time offset (s)", time_offset_);
-    status.add("odometry time offset, estimate (s)", time_offset_estimate_);
-    status.add("odometry time offset",
-               options_.tracker.learning.odometry_time_offset.estimate ? "learned" : "fixed");
-  }
-  status.add("degeneracy of the last match (min / max information)", degeneracy_);
-  status.add("weakest direction of the last match (x, y, theta)",
-             std::to_string(weakest_direction_.x()) + ", " + std::to_string(weakest_direction_.y()) + ", " +
-                 std::to_string(weakest_direction_.z()));
-  status.add("wheel noise scale learned (xy, theta)",
-             std::to_string(noise_scale_.xy) + ", " + std::to_string(noise_scale_.theta));
-  status.add("queued scans", queued);
-  status.add("preset", options_.preset);
-  if (options_.tracker.prediction.use_imu)
-    status.add("IMU", imu_stale_ ? "stale: rotation predicted without it" : "in use");
-
-  const bool scans_arriving =
-      !last_scan_time_.isZero() && (now - last_scan_time_).toSec() <= options_.diagnostics.window;
-  if (waiting_for_tf_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, tf_wait_text_);
-  } else if (!scans_arriving) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   last_scan_time_.isZero() ? "no scans received yet" : "no scans received recently");
-  } else if (matched > 0 && failure_ratio >= options_.diagnostics.error_failure_ratio) {
-    status.summaryf(diagnostic_msgs::DiagnosticStatus::ERROR, "%.0f%% of scans failed to match",
-                    100.0 * failure_ratio);
-  } else if (matched > 0 && failure_ratio >= options_.diagnostics.warn_failure_ratio) {
-    status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%.0f%% of scans failed to match",
-                    100.0 * failure_ratio);
-  } else if (options_.tracker.prediction.use_imu && imu_stale_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   "IMU stale or missing: rotation predicted without it");
-  } else if (dropped_total > last_reported_drops_) {
-    status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
-                    "dropping scans: %u dropped so far (processing is slower than the input)", dropped_total);
-  } else if (options_.diagnostics.min_rate > 0.0 && rate < options_.diagnostics.min_rate) {
-    status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "scan rate %.2f Hz below %.2f Hz", rate,
-                    options_.diagnostics.min_rate);
-  } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
-  }
-  last_reported_drops_ = dropped_total;
+  if (log_throttle_.allow(key, steadySeconds(), period)) ROS_WARN_STREAM("[" << name_ << "] " << text);
 }
 
 }  // namespace hglasm_odometry

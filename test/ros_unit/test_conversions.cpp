@@ -86,6 +86,25 @@ TEST(RangeScanFromMsg, BeamTimesAreCopiedAndNonFiniteOnesDropped) {
   }
 }
 
+TEST(RangeScanFromMsg, IntoAScanReusesItsStorage) {
+  hglasm::RangeScan scan;
+  rangeScanFromMsg(makeScan(360, -1.0, 0.01, 4.0f), &scan);
+  const float* storage = scan.ranges.data();
+  sensor_msgs::LaserScan next = makeScan(180, 0.5, 0.02, 2.0f);
+  next.range_min = std::numeric_limits<float>::quiet_NaN();
+  next.time_increment = 1e-4f;
+  rangeScanFromMsg(next, &scan);
+  EXPECT_EQ(scan.ranges.data(), storage);
+  EXPECT_EQ(scan.ranges, next.ranges);
+  // Every field as the returning conversion gives it.
+  const hglasm::RangeScan fresh = rangeScanFromMsg(next);
+  EXPECT_EQ(scan.angle_min, fresh.angle_min);
+  EXPECT_EQ(scan.angle_increment, fresh.angle_increment);
+  EXPECT_EQ(scan.range_min, fresh.range_min);
+  EXPECT_EQ(scan.range_max, fresh.range_max);
+  EXPECT_EQ(scan.time_increment, fresh.time_increment);
+}
+
 TEST(RangeScanFromMsg, NonFiniteRangeLimitsDoNotInvalidateEveryBeam) {
   sensor_msgs::LaserScan msg = makeScan(3, 0.0, 0.1, 5.0f);
   msg.range_min = std::numeric_limits<float>::quiet_NaN();
@@ -386,6 +405,11 @@ TEST(FrameIds, LeadingSlashesAreStripped) {
   EXPECT_EQ(stripLeadingSlash("odom"), "odom");
   EXPECT_EQ(stripLeadingSlash("/"), "");
   EXPECT_EQ(stripLeadingSlash(""), "");
+  const std::string frame_id = "//laser";
+  const std::string_view view = withoutLeadingSlash(frame_id);
+  EXPECT_EQ(view, "laser");
+  EXPECT_EQ(view.data(), frame_id.data() + 2) << "a view into the frame id, not a copy";
+  EXPECT_EQ(withoutLeadingSlash("/"), "");
 }
 
 geometry_msgs::PoseWithCovarianceStamped setPoseMsg(const std::string& frame) {

@@ -1,7 +1,8 @@
 // The node's outgoing messages from a tracker update: ~odom (frames, pose, covariances, a non-finite
 // velocity), ~match (enum constants, clamped counts, NaN-free floats, poses only for attempted matches, the
 // scan's frame), the ~ga_population markers (finite individuals only, heading segments, arrows) and the
-// ~local_map cloud (fields, frame, points moved into odom_frame, finite only; not latched per the README).
+// ~local_map cloud (fields, frame, points moved into odom_frame, finite only; not latched per the README)
+// and the ~path history (newest poses, oldest first, each at its scan's stamp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 
 #include "hglasm_odometry/ros/conversions.h"
+#include "hglasm_odometry/ros/output_publisher.h"
 
 namespace hglasm_odometry {
 namespace {
@@ -296,6 +298,27 @@ TEST(LocalMapCloud, NonFinitePointsAreLeftOutAndANonFiniteFrameGivesNone) {
   EXPECT_TRUE(none.data.empty());
   EXPECT_EQ(none.fields.size(), 3u) << "an empty cloud still says what its points would be";
   EXPECT_TRUE(pointCloudMsgFromPoints(header, hglasm::Pose2D(), {}).data.empty());
+}
+
+TEST(PathMsg, TheNewestPosesOldestFirstInTheHeadersFrame) {
+  PathHistory history(3);
+  for (int i = 0; i < 5; ++i) history.add(ros::Time(10.0 + i), hglasm::Pose2D(i, -i, 0.1 * i));
+  EXPECT_EQ(history.size(), 3u);
+  nav_msgs::Path path;
+  history.toMsg(makeHeader(14.0, "odom"), &path);
+  EXPECT_EQ(path.header.stamp, ros::Time(14.0));
+  EXPECT_EQ(path.header.frame_id, "odom");
+  ASSERT_EQ(path.poses.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(path.poses[i].header.stamp, ros::Time(12.0 + i));
+    EXPECT_EQ(path.poses[i].header.frame_id, "odom");
+    EXPECT_EQ(path.poses[i].pose, poseMsgFromPose2D(hglasm::Pose2D(2 + i, -2 - i, 0.1 * (2 + i))));
+  }
+  history.clear();
+  history.add(ros::Time(20.0), hglasm::Pose2D(7.0, 0.0, 0.0));
+  history.toMsg(makeHeader(20.0, "odom"), &path);  // the message is reused: shorter now
+  ASSERT_EQ(path.poses.size(), 1u);
+  EXPECT_EQ(path.poses[0].pose.position.x, 7.0);
 }
 
 /// The rostest checks the connection says latching 0; the README's topic table must say so too.

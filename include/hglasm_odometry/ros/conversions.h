@@ -7,6 +7,7 @@
 #include <boost/array.hpp>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <geometry_msgs/Pose.h>
@@ -36,6 +37,8 @@ constexpr double kUnobservedVariance = 1e6;
 /// ranges per REP-117). A non-finite or negative range_min becomes 0 and a non-finite or non-positive
 /// range_max becomes +inf, so one bad header field does not invalidate every beam.
 hglasm::RangeScan rangeScanFromMsg(const sensor_msgs::LaserScan& msg);
+/// The same into *scan, reusing its storage: nothing allocated per scan once it has held the longest one.
+void rangeScanFromMsg(const sensor_msgs::LaserScan& msg, hglasm::RangeScan* scan);
 
 /// The planar part of base -> laser.
 struct LaserMount {
@@ -107,6 +110,8 @@ bool poseRequestFromMsg(const geometry_msgs::PoseWithCovarianceStamped& msg, con
 
 /// "/laser" -> "laser": tf2 rejects frame ids with a leading slash, old bags (ccny) still carry them.
 std::string stripLeadingSlash(const std::string& frame_id);
+/// The same without a copy (a view into `frame_id`), for comparing the frame of every message.
+std::string_view withoutLeadingSlash(std::string_view frame_id);
 
 /// A float for a message field: 0 for a non-finite value.
 float finiteFloat(double value);

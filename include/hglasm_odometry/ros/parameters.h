@@ -21,17 +21,9 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include "hglasm_odometry/core/odometry_tracker.h"
+#include "hglasm_odometry/ros/diagnostics.h"  // DiagnosticsOptions
 
 namespace hglasm_odometry {
-
-/// Thresholds of the /diagnostics status.
-struct DiagnosticsOptions {
-  double min_rate = 1.0;             ///< Hz: a lower scan rate (while scans arrive) is WARN; 0 disables
-  double warn_failure_ratio = 0.2;   ///< fraction of failed matches in the window that is WARN
-  double error_failure_ratio = 0.5;  ///< ... that is ERROR
-  double window = 10.0;              ///< seconds of statistics behind each status
-  double period = 1.0;               ///< seconds between /diagnostics messages (wall clock)
-};
 
 /// Continuing from a given pose: the ~set_pose service is always offered; a topic is optional.
 struct SetPoseOptions {
