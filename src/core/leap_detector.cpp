@@ -16,6 +16,31 @@ double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3
 
 LeapDetector::LeapDetector(const LeapOptions& options) : options_(options) {}
 
+void LeapDetector::remember(const LeapVerdict& verdict, bool scene_as_usual) {
+  wrong_probability_ = verdict.wrong_probability;
+  if (scene_as_usual) {
+    const double keep = std::exp2(-1.0 / kFaultHalfLife);
+    faults_ = keep * faults_ + ((verdict.leapt || verdict.deferred) ? 1.0 : 0.0);
+    scans_ = keep * scans_ + 1.0;
+  }
+  pending_ = verdict.deferred;
+  pending_correction_ = verdict.correction;
+  pending_covariance_ = verdict.correction_covariance;
+}
+
+bool LeapDetector::confirms(const LeapVerdict& verdict, const LeapHypotheses& h) const {
+  if (!pending_) return false;
+  // The last scan's correction applied to this prediction, against this scan's match (the map's frame):
+  // one slip of the wheels puts both at the same pose.
+  const Pose2D expected = h.map_frame.inverse() * pending_correction_ * h.map_frame * h.prior.mean;
+  const Pose2D matched = h.map_frame.inverse() * verdict.correction * h.map_frame * h.prior.mean;
+  const Eigen::Vector3d offset(matched.x - expected.x, matched.y - expected.y,
+                               normalizeAngle(matched.theta - expected.theta));
+  const Eigen::Matrix3d covariance = pending_covariance_ + verdict.correction_covariance + h.covariance;
+  const double mahalanobis_sq = offset.dot(covariance.ldlt().solve(offset));
+  return mahalanobis_sq <= options_.max_mahalanobis * options_.max_mahalanobis;
+}
+
 double LeapDetector::wrongPrior() const {
   // A prediction that was wrong tends to stay wrong for a while.
   return std::clamp(
@@ -71,7 +96,7 @@ double LeapDetector::predictionLogPosterior(const ScanJudge& judge, const LeapHy
 
 LeapVerdict LeapDetector::test(const ScanJudge& judge, const LeapHypotheses& h, bool informative,
                                const MatchCandidate& tight,
-                               const std::function<MatchCandidate()>& search_wide) const {
+                               const std::function<MatchCandidate()>& search_wide, bool may_defer) const {
   LeapVerdict verdict;
   verdict.chosen = tight;
   verdict.wrong_probability = h.wrong_probability;
@@ -92,11 +117,17 @@ LeapVerdict LeapDetector::test(const ScanJudge& judge, const LeapHypotheses& h, 
     }
     const MatchCandidate* loser = &wide;
     if (leap.best() > stay_score) {
-      verdict.chosen = wide;
-      verdict.wide = true;
-      verdict.leapt = far(wide);
-      verdict.wrong_probability = leap.wrongProbability();
-      loser = &tight;
+      verdict.correction = h.map_frame * wide.match.pose * h.prior.mean.inverse() * h.map_frame.inverse();
+      verdict.correction_covariance = wide.match.covariance;
+      if (far(wide) && may_defer && confirmationRequired() && !confirms(verdict, h)) {
+        verdict.deferred = true;  // the tight match stands until the next scan says the same
+      } else {
+        verdict.chosen = wide;
+        verdict.wide = true;
+        verdict.leapt = far(wide);
+        verdict.wrong_probability = leap.wrongProbability();
+        loser = &tight;
+      }
     } else {
       verdict.rejected = wide.acceptable && far(wide);
     }

@@ -194,8 +194,9 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   TrackerDiagnostics& diagnostics = update->diagnostics;
   const Prior prior = priorFor(prediction);
   const SearchEffort wide_search = effortOf(options_.matcher.genetic);  // the preset's whole box
-  const LeapHypotheses h = leap_detector_.hypotheses(prior.mean, prior.covariance,
-                                                     boxVariances(wide_search.box, options_.search.sigmas));
+  LeapHypotheses h = leap_detector_.hypotheses(prior.mean, prior.covariance,
+                                               boxVariances(wide_search.box, options_.search.sigmas));
+  h.map_frame = local_map_.frame();
   const ScanJudge scan_judge = judge(scan);
   diagnostics.search =
       prior.informative ? searchAround(options_.matcher.genetic, options_.search, h.covariance) : wide_search;
@@ -215,8 +216,9 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
       return candidate(scan_judge, match, h.prior);
     };
   }
-  const LeapVerdict verdict = leap_detector_.test(scan_judge, h, prior.informative, tight, search_wide);
-  leap_detector_.remember(verdict.wrong_probability);
+  const LeapVerdict verdict = leap_detector_.test(scan_judge, h, prior.informative, tight, search_wide,
+                                                  !prediction.rotation_from_imu);
+  leap_detector_.remember(verdict, tight.acceptable && fitness_.usual(tight.fitness_ratio));
   if (verdict.wide) {
     diagnostics.search = wide_search;
     if (population_out) *population_out = wide_population;
@@ -228,10 +230,12 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   const MatchCandidate& chosen = verdict.chosen;
   if (!chosen.acceptable) return false;
   diagnostics.fitness_ratio = chosen.fitness_ratio;
-  fitness_.add(chosen.fitness_ratio);
+  // A scan whose leap waits for confirmation fits poorly where it stays: not a usual fit.
+  if (!verdict.deferred) fitness_.add(chosen.fitness_ratio);
   *estimate = estimateFrom(chosen, prior);
-  // After a leap the wheels were wrong beyond their noise: an outlier, not their noise.
-  learner_.addMatchedScan(prediction, last_stamp_, scanOnlyPose(chosen.match), !update->leap);
+  // After a leap (or a deferred one) the wheels were wrong beyond their noise: an outlier, not their noise.
+  learner_.addMatchedScan(prediction, last_stamp_, scanOnlyPose(chosen.match),
+                          !update->leap && !verdict.deferred);
   applyLearnedModels();
   return true;
 }
@@ -241,6 +245,7 @@ void OdometryTracker::record(const LeapVerdict& verdict, TrackerUpdate* update) 
   update->leap = verdict.leapt;
   diagnostics.prediction_doubted = verdict.doubted;
   diagnostics.jump_rejected = verdict.rejected;
+  diagnostics.leap_deferred = verdict.deferred;
   diagnostics.leap_probability = verdict.wrong_probability;
   const MatchResult& match = verdict.chosen.match;
   diagnostics.match = match;
@@ -355,7 +360,7 @@ void OdometryTracker::updateMap(const Scan& scan, bool usable, TrackerUpdate* up
   KeyframeCandidate candidate;
   candidate.pose = pose_;
   candidate.usable = usable;
-  candidate.leapt = update->leap;
+  candidate.leapt = update->leap || update->diagnostics.leap_deferred;
   candidate.matched = update->matched;
   candidate.match_failed = update->fallback;
   candidate.fitness_ratio = update->diagnostics.fitness_ratio;

@@ -339,6 +339,8 @@ void visitTrackerOptions(Params& tree, hglasm::TrackerOptions* options) {
   tree.number("leap/probability", &tracker.leap.probability, 0.0, 0.5, true);
   tree.number("leap/persistence", &tracker.leap.persistence, 0.0, 1.0, true);
   tree.number("leap/likelihood_outlier", &tracker.leap.likelihood_outlier, 0.0, 1.0, true);
+  tree.boolean("leap/confirm", &tracker.leap.confirm);
+  tree.number("leap/confirm_below", &tracker.leap.confirm_below, 0.0, 1.0, true);
 
   // The local map the scans are matched against.
   tree.positiveInteger("local_map/keyframes", &tracker.local_map.keyframes);

@@ -36,6 +36,7 @@ MatchCandidate candidateAt(const Pose2D& pose, const LeapHypotheses& h, const hg
   candidate.match.pose = candidate.match.scan_only_pose = pose;
   candidate.match.status = hglasm::MatchStatus::kOk;
   candidate.match.scan_information = Eigen::Vector3d(1e4, 1e4, 1e5).asDiagonal();
+  candidate.match.covariance = Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal();
   candidate.match.prealign_ms = 1.0;
   candidate.match.evaluations = 100;
   const Eigen::Vector3d offset = hglasm::poseDifference(pose, h.prior.mean);
@@ -64,7 +65,7 @@ TEST(LeapDetector, TheWrongHypothesisIsWiderAndItsOddsFollowTheLastScan) {
   ASSERT_TRUE(verdict.wide);
   EXPECT_GT(verdict.wrong_probability, 0.999);
   EXPECT_DOUBLE_EQ(detector.wrongPrior(), 1e-3) << "testing changes nothing";
-  detector.remember(verdict.wrong_probability);
+  detector.remember(verdict, false);
   EXPECT_EQ(detector.wrongProbability(), verdict.wrong_probability);
   EXPECT_NEAR(detector.wrongPrior(), 0.5, 1e-3);
   detector.reset();
@@ -185,6 +186,104 @@ TEST(LeapDetector, NothingAcceptableKeepsThePriorOdds) {
   EXPECT_TRUE(verdict.doubted);
   EXPECT_FALSE(verdict.chosen.acceptable);
   EXPECT_EQ(verdict.wrong_probability, h.wrong_probability);
+}
+
+/// A detector that has seen `scans` scans, `faults` of them (spread evenly) with a far leap to a usual fit.
+LeapDetector withHistory(int scans, int faults, const hglasm::LeapOptions& options = {}) {
+  LeapDetector detector(options);
+  for (int i = 0; i < scans; ++i) {
+    LeapVerdict verdict;
+    verdict.leapt = faults > 0 && i % (scans / faults) == 0;
+    detector.remember(verdict, true);
+  }
+  detector.reset();  // forgets the odds of the last scan, not the wheels' record
+  return detector;
+}
+
+/// The wheels put the robot `offset` (x, m) from where it is: the wide search finds the truth.
+LeapVerdict slipped(const LeapDetector& detector, const Room& room, double offset) {
+  const LeapHypotheses h = detector.hypotheses(Pose2D(offset, 0.0, 0.0),
+                                               Eigen::Vector3d(1e-3, 1e-3, 1e-4).asDiagonal(), kBoxVariances);
+  const MatchCandidate tight = candidateAt(Pose2D(offset - 0.02, 0.0, 0.0), h, room.judge());
+  return detector.test(room.judge(), h, true, tight, [&] { return candidateAt(Pose2D(), h, room.judge()); });
+}
+
+TEST(LeapDetector, WheelsRarelyWrongLeapOnlyWhenTheNextScanAsksForTheSameCorrection) {
+  const Room room;
+  LeapDetector detector = withHistory(5000, 1);
+  EXPECT_LT(detector.faultRate(), detector.options().confirm_below);
+  ASSERT_TRUE(detector.confirmationRequired());
+  // A first scan asks for 0.4 m: deferred, the match near the prediction stands.
+  LeapVerdict first = slipped(detector, room, 0.4);
+  EXPECT_TRUE(first.deferred);
+  EXPECT_FALSE(first.leapt);
+  EXPECT_FALSE(first.wide);
+  EXPECT_NEAR(first.chosen.match.pose.x, 0.38, 1e-12);
+  EXPECT_NEAR(first.correction.x, -0.4, 1e-12) << "match = correction * prediction";
+  detector.remember(first, false);
+  // The next asks for the same: the wheels slipped, the leap is taken.
+  const LeapVerdict same = slipped(detector, room, 0.4);
+  EXPECT_TRUE(same.leapt);
+  EXPECT_FALSE(same.deferred);
+  EXPECT_EQ(same.chosen.match.pose.x, 0.0);
+  // After a deferred 0.4 m, a scan asking for 0.8 m points elsewhere: deferred again.
+  detector.remember(first, false);
+  const LeapVerdict other = slipped(detector, room, 0.8);
+  EXPECT_TRUE(other.deferred);
+  EXPECT_FALSE(other.leapt);
+  // With nothing deferred before, even the same correction waits.
+  detector.remember(LeapVerdict(), false);
+  EXPECT_TRUE(slipped(detector, room, 0.4).deferred);
+}
+
+TEST(LeapDetector, WheelsOftenWrongLeapAtOnce) {
+  const Room room;
+  const LeapDetector detector = withHistory(2000, 80);  // 4 % of the scans, as intel's wheels do
+  EXPECT_GT(detector.faultRate(), detector.options().confirm_below);
+  EXPECT_FALSE(detector.confirmationRequired());
+  const LeapVerdict verdict = slipped(detector, room, 0.4);
+  EXPECT_TRUE(verdict.leapt);
+  EXPECT_FALSE(verdict.deferred);
+  // Without leap/confirm the same holds for trustworthy wheels.
+  hglasm::LeapOptions options;
+  options.confirm = false;
+  const LeapDetector unconfirmed = withHistory(5000, 1, options);
+  EXPECT_FALSE(unconfirmed.confirmationRequired());
+  EXPECT_TRUE(slipped(unconfirmed, room, 0.4).leapt);
+}
+
+TEST(LeapDetector, OnlyScansThatFitAsUsualNearThePredictionCountTowardsTheWheelsRecord) {
+  LeapDetector detector;
+  EXPECT_DOUBLE_EQ(detector.faultRate(), detector.options().confirm_below)
+      << "the rate over kTrustScans to start";
+  EXPECT_FALSE(detector.confirmationRequired()) << "nothing known yet";
+  LeapVerdict leapt;
+  leapt.leapt = true;
+  for (int i = 0; i < 100; ++i) detector.remember(leapt, false);
+  EXPECT_DOUBLE_EQ(detector.faultRate(), detector.options().confirm_below)
+      << "leaps where the scan fits poorly near the prediction say nothing of the wheels";
+  detector.remember(LeapVerdict(), true);
+  EXPECT_TRUE(detector.confirmationRequired()) << "a scan that fit as usual, and no fault";
+  detector.remember(leapt, true);
+  EXPECT_FALSE(detector.confirmationRequired()) << "a fault early on: the wheels are corrected at once";
+  LeapVerdict deferred;
+  deferred.deferred = true;
+  const double before = detector.faultRate();
+  detector.remember(deferred, true);
+  EXPECT_GT(detector.faultRate(), before) << "a deferred leap counts as one";
+}
+
+TEST(LeapDetector, AnImusRotationIsCorrectedAtOnce) {
+  const Room room;
+  const LeapDetector detector = withHistory(5000, 1);
+  ASSERT_TRUE(detector.confirmationRequired());
+  const LeapHypotheses h = detector.hypotheses(Pose2D(0.4, 0.0, 0.0),
+                                               Eigen::Vector3d(1e-3, 1e-3, 1e-4).asDiagonal(), kBoxVariances);
+  const MatchCandidate tight = candidateAt(Pose2D(0.38, 0.0, 0.0), h, room.judge());
+  const LeapVerdict verdict = detector.test(
+      room.judge(), h, true, tight, [&] { return candidateAt(Pose2D(), h, room.judge()); }, false);
+  EXPECT_TRUE(verdict.leapt);
+  EXPECT_FALSE(verdict.deferred);
 }
 
 }  // namespace

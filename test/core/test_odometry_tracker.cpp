@@ -600,8 +600,9 @@ struct FastTurnRun {
 /// each scan's beams measured over `sweep_fraction` of the scan period (0: all at once).
 FastTurnRun runFastTurns(bool use_imu, double turn_rate, double scan_rate, double turn_scale, double bias,
                          double noise_density, const hglasm::GyroOptions& gyro = {},
-                         double sweep_fraction = 0.0) {
+                         double sweep_fraction = 0.0, bool confirm_leaps = true) {
   TrackerOptions options;
+  options.leap.confirm = confirm_leaps;
   options.prediction.use_imu = use_imu;
   options.prediction.imu = gyro;
   const Path path = hglasm_test::squareWithSpins(turn_rate);
@@ -647,14 +648,20 @@ void printRun(const char* what, const FastTurnRun& run) {
 
 TEST(OdometryTracker, AGyroTracksFastTurnsThatTheWheelsGetWrong) {
   // A 5 Hz laser (a low-cost 360-degree scanner), spins at 180 deg/s: 36 degrees between scans, of which
-  // the slipping wheels count 30 %. The wheels' 25-degree error per scan is far beyond their noise model:
-  // without the gyro only the leap test recovers it, leaping at every spin (each leap needs the scan's
-  // evidence to outweigh the odds against it); with the gyro the prediction holds.
+  // the slipping wheels count 30 %. The wheels' 25-degree error per scan is far beyond their noise model,
+  // and only at the spins: wheels right everywhere else earn the trust that makes a leap wait for the next
+  // scan's confirmation, which a spin's growing error never gives, and the wheels alone are lost. Without
+  // that (leap/confirm false) the leap test recovers every spin, leaping each time; with the gyro the
+  // prediction holds.
   const FastTurnRun wheels = runFastTurns(false, kPi, 5.0, 0.3, 0.0, 0.0);
+  const FastTurnRun unconfirmed = runFastTurns(false, kPi, 5.0, 0.3, 0.0, 0.0, {}, 0.0, false);
   const FastTurnRun gyro = runFastTurns(true, kPi, 5.0, 0.3, kGyroBias, kGyroNoiseDensity);
   printRun("5 Hz, wheels alone:", wheels);
+  printRun("5 Hz, wheels, leaps at once:", unconfirmed);
   printRun("5 Hz, gyro:", gyro);
-  EXPECT_GE(wheels.leaps, 20) << "the scenario is not hard for the wheels";
+  EXPECT_GT(wheels.worst_rotation_error, hglasm_test::deg(20.0)) << "the scenario is not hard for the wheels";
+  EXPECT_GE(unconfirmed.leaps, 20);
+  EXPECT_LT(unconfirmed.worst_rotation_error, hglasm_test::deg(1.0));
   EXPECT_EQ(gyro.rotations_from_imu, gyro.scans) << "every step's rotation from the gyro";
   EXPECT_EQ(gyro.fallbacks, 0);
   EXPECT_EQ(gyro.leaps, 0);
@@ -688,11 +695,12 @@ TEST(OdometryTracker, WithoutLearningTheGyroBiasTheSameRunNeedsLeaps) {
 }
 
 TEST(OdometryTracker, AGyroSparesTheLeapsThatFastTurnsOtherwiseNeed) {
-  // 10 Hz, 180 deg/s, wheels counting half of each turn: 9 degrees off per scan. The leap test recovers
-  // every one of them (flagged as leaps); with the gyro the prediction holds and no leap is needed.
-  const FastTurnRun wheels = runFastTurns(false, kPi, 10.0, 0.5, 0.0, 0.0);
+  // 10 Hz, 180 deg/s, wheels counting half of each turn: 9 degrees off per scan. The leap test taking leaps
+  // at once (leap/confirm false) recovers every one of them (flagged as leaps); with the gyro the prediction
+  // holds and no leap is needed.
+  const FastTurnRun wheels = runFastTurns(false, kPi, 10.0, 0.5, 0.0, 0.0, {}, 0.0, false);
   const FastTurnRun gyro = runFastTurns(true, kPi, 10.0, 0.5, kGyroBias, kGyroNoiseDensity);
-  printRun("10 Hz, wheels alone:", wheels);
+  printRun("10 Hz, wheels, leaps at once:", wheels);
   printRun("10 Hz, gyro:", gyro);
   EXPECT_GE(wheels.leaps, 20);
   EXPECT_LE(gyro.leaps, 2);

@@ -18,7 +18,7 @@ struct KeyframeOptions {
 struct KeyframeCandidate {
   Pose2D pose;                 ///< the base's estimated pose
   bool usable = false;         ///< enough points to be matched (and to be a keyframe)
-  bool leapt = false;          ///< the estimate leapt from the prediction
+  bool leapt = false;          ///< the estimate leapt from the prediction (or a leap was deferred)
   bool matched = false;        ///< a match was attempted
   bool match_failed = false;   ///< no match was accepted: the prediction was integrated
   double fitness_ratio = 0.0;  ///< at the estimated pose

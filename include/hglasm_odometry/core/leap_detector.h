@@ -25,6 +25,15 @@ struct LeapOptions {
   double persistence = 0.5;
   /// Outlier share of the scan likelihood that weighs leaps: a point far from the map costs log(outlier).
   double likelihood_outlier = 0.1;
+  /// Wheels that have rarely been wrong (leaps of scans that fit the map as usual near the prediction, in
+  /// fewer than `confirm_below` of those scans, forgetting with a half-life of kFaultHalfLife scans; the
+  /// count starts at that rate over kTrustScans scans) leap only once the next scan's wide search asks for
+  /// the same correction of its prediction (within max_mahalanobis): wheels that slipped stay off by what
+  /// they lost, while a scan that fits some other place (a changed scene, a view the map lacks, repeated
+  /// structure) points elsewhere the next time. Wheels that are wrong more often, and rotations predicted by
+  /// an IMU (whose bias the scans teach), are corrected at once.
+  bool confirm = true;
+  double confirm_below = 1e-3;  ///< the prior odds of a leap, as `probability`
 };
 
 /// The two hypotheses a scan is matched under, in the local map's frame (the laser's pose).
@@ -34,6 +43,7 @@ struct LeapHypotheses {
   PosePrior wide_prior;  ///< the prediction is wrong: the pose anywhere in the preset's box
   Eigen::Matrix3d wide_covariance = Eigen::Matrix3d::Zero();
   double wrong_probability = 0.0;  ///< prior probability of the second
+  Pose2D map_frame;  ///< the local map's frame in the odometry frame (where a correction is remembered)
 };
 
 /// A match and how well it explains the scan.
@@ -65,7 +75,13 @@ struct LeapVerdict {
   bool wide = false;               ///< the wide search's match won
   bool leapt = false;              ///< ... and lies beyond max_mahalanobis of the prediction
   bool rejected = false;           ///< a wide match that far lacked the evidence: the prediction held
+  bool deferred = false;           ///< a wide match that far won, but awaits the next scan's confirmation
   double wrong_probability = 0.0;  ///< posterior probability that the prediction was wrong
+  /// The far wide match as a correction of the prediction, taken or deferred: match = correction *
+  /// prediction in the odometry frame. Wheels that slipped stay off by the same one: it moves every later
+  /// prediction (their increments are right again) onto the truth.
+  Pose2D correction;
+  Eigen::Matrix3d correction_covariance = Eigen::Matrix3d::Zero();
 };
 
 /// Its one piece of state is how likely the last scan's prediction was wrong: the next scan's prior odds
@@ -99,11 +115,23 @@ class LeapDetector {
   /// two matches compete by posterior, with the beams' free space (which the likelihood field leaves out: a
   /// scan occluded by people fits the map better turned onto another corridor, with beams through its
   /// walls). `informative`: the prior holds information (else no posterior is formed).
+  /// `may_defer`: a far leap may wait for confirmation (LeapOptions::confirm; false for an IMU's rotation).
   LeapVerdict test(const ScanJudge& judge, const LeapHypotheses& h, bool informative,
-                   const MatchCandidate& tight, const std::function<MatchCandidate()>& search_wide) const;
+                   const MatchCandidate& tight, const std::function<MatchCandidate()>& search_wide,
+                   bool may_defer = true) const;
 
-  /// The probability that this scan's prediction was wrong (a verdict's): the next scan's prior follows it.
-  void remember(double wrong_probability) { wrong_probability_ = wrong_probability; }
+  /// The verdict on this scan: the next scan's prior follows its probability that the prediction was wrong,
+  /// and a deferred leap waits for the next scan to confirm it. `scene_as_usual`: the match near the
+  /// prediction fit the map as scans usually do, so a far leap was the wheels' fault, not the scene's.
+  void remember(const LeapVerdict& verdict, bool scene_as_usual);
+  /// How often the wheels have been wrong beyond their noise (far leaps per scan that fit as usual), so far.
+  double faultRate() const {
+    return (options_.confirm_below * kTrustScans + faults_) / (kTrustScans + scans_);
+  }
+  /// Whether a far leap waits for the next scan's confirmation (LeapOptions::confirm).
+  bool confirmationRequired() const { return options_.confirm && faultRate() < options_.confirm_below; }
+  static constexpr double kFaultHalfLife = 2000.0;  // scans
+  static constexpr double kTrustScans = 1000.0;
   /// The prior probability that the prediction of the coming scan is wrong.
   double wrongPrior() const;
   /// The probability remembered last (0 after reset()).
@@ -112,12 +140,23 @@ class LeapDetector {
   bool far(const MatchCandidate& candidate) const {
     return candidate.mahalanobis_sq > options_.max_mahalanobis * options_.max_mahalanobis;
   }
-  void reset() { wrong_probability_ = 0.0; }
+  void reset() {
+    wrong_probability_ = 0.0;
+    pending_ = false;
+  }
   const LeapOptions& options() const { return options_; }
 
  private:
+  /// Whether `verdict`'s far wide match asks for the correction the last scan deferred.
+  bool confirms(const LeapVerdict& verdict, const LeapHypotheses& h) const;
+
   LeapOptions options_;
   double wrong_probability_ = 0.0;
+  bool pending_ = false;  // the last scan deferred a leap by pending_correction_
+  double faults_ = 0.0;   // far leaps (taken or deferred) of scans that fit as usual, forgotten over time
+  double scans_ = 0.0;    // scans that fit as usual, forgotten alike
+  Pose2D pending_correction_;
+  Eigen::Matrix3d pending_covariance_ = Eigen::Matrix3d::Zero();
 };
 
 }  // namespace hglasm

@@ -82,6 +82,9 @@ struct TrackerDiagnostics {
   Eigen::Vector3d weakest_direction = Eigen::Vector3d::Zero();
   bool prediction_doubted = false;  ///< the match left the prediction: the preset's box was searched too
   bool jump_rejected = false;  ///< a match far from the prediction lacked the evidence: the prediction held
+  /// A far match won but waits for the next scan to ask for the same correction (LeapOptions::confirm):
+  /// the prediction held this time, and the scan is no keyframe.
+  bool leap_deferred = false;
   double leap_probability = 0.0;  ///< posterior probability that the prediction was wrong
   bool reanchored = false;        ///< the scan did not fit the local map: the map restarted from it
   double table_build_ms = 0.0;    ///< lookup-table build of the new local map (wall ms; 0 if none)
