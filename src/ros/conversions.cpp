@@ -44,6 +44,7 @@ void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
   match->status = update.stale ? static_cast<uint8_t>(Match::STATUS_STALE) : toMsg(d.match.status);
   match->status_text = update.stale ? "stale" : hglasm::toString(d.match.status);
   match->jump_rejected = d.jump_rejected;
+  match->leap_deferred = d.leap_deferred;
   match->prediction_doubted = d.prediction_doubted;
   match->leap = update.leap;
   match->leap_probability = finiteFloat(d.leap_probability);

@@ -97,6 +97,7 @@ hglasm::PipelineUpdate matchedUpdate() {
   update.keyframe_id = 7;
   update.diagnostics.map_keyframes = 3;
   update.diagnostics.leap_probability = 0.25;
+  update.diagnostics.leap_deferred = true;
   update.diagnostics.learned.wheel_noise.xy = 2.0;
   update.diagnostics.learned.wheel_noise.theta = 0.5;
   update.diagnostics.odometry_time_offset = 0.125;
@@ -138,6 +139,7 @@ TEST(MatchMsg, AttemptedMatch) {
   EXPECT_EQ(match.keyframe_id, 7u);
   EXPECT_EQ(match.map_keyframes, 3u);
   EXPECT_EQ(match.leap_probability, 0.25f);
+  EXPECT_TRUE(match.leap_deferred);
   EXPECT_EQ(match.noise_scale_xy, 2.0f);
   EXPECT_EQ(match.noise_scale_theta, 0.5f);
   EXPECT_EQ(match.odometry_time_offset, 0.125f);
