@@ -4,30 +4,12 @@
 #include <cmath>
 
 namespace hglasm {
-namespace {
-
-/// Whether the matcher's fine table is the graded one that scans are judged on.
-bool matcherHasGradedTable(Algorithm algorithm) {
-  return algorithm == Algorithm::kHglasmG || algorithm == Algorithm::kGlasmG;
-}
-
-}  // namespace
 
 std::vector<LookupTableOptions> mapTables(const MatcherOptions& matcher) {
-  const bool lookup_ga = usesGeneticStage(matcher.algorithm) && !usesPolarPairing(matcher.algorithm);
-  const TableKind kind =
-      matcherHasGradedTable(matcher.algorithm) || !lookup_ga ? TableKind::kGraded : TableKind::kBinary;
-  LookupTableOptions fine = matcher.table, coarse = matcher.coarse_table, graded = matcher.table;
-  fine.kind = coarse.kind = kind;
-  graded.kind = TableKind::kGraded;
-  if (!lookup_ga) return {graded};
-  if (kind == TableKind::kGraded) return {fine, coarse};
-  return {fine, coarse, graded};
+  return {matcher.table, matcher.coarse_table};
 }
 
-const LookupTable& judgingTable(const LocalMap& map) {
-  return map.table(map.tableCount() == 3 ? 2 : kFineTable);
-}
+const LookupTable& judgingTable(const LocalMap& map) { return map.table(kFineTable); }
 
 double likelihoodWeight(double independent_points, std::size_t points, double evidence_scale) {
   const double weight =

@@ -47,41 +47,52 @@ inline long floorToLong(double value) {
 
 }  // namespace
 
-LookupTable::LookupTable(const LookupTableOptions& options) : options_(options) {
-  // Guard against nonsense sizes here too; the ROS layer validates and names the parameter.
-  if (!(options_.cell_size > 1e-4)) options_.cell_size = LookupTableOptions().cell_size;
-  if (!(options_.sigma > 0.0)) options_.sigma = LookupTableOptions().sigma;
-  if (!(options_.cutoff >= options_.cell_size))
-    options_.cutoff = std::max(options_.cell_size, 3 * options_.sigma);
-  inv_cell_size_ = 1.0 / options_.cell_size;
-  buildKernel();
+TableKernel gradedKernel(const LookupTableOptions& options) {
+  // The value of a cell is the likelihood of the distance from the reference point's cell centre to its own.
+  TableKernel kernel;
+  kernel.radius = static_cast<int>(std::ceil(options.cutoff * (1.0 / options.cell_size) - 1e-9));
+  const int side = 2 * kernel.radius + 1;
+  kernel.values.assign(static_cast<std::size_t>(side) * side, 0);
+  const double inv_two_sigma_sq = 1.0 / (2.0 * options.sigma * options.sigma);
+  for (int dy = -kernel.radius; dy <= kernel.radius; ++dy) {
+    for (int dx = -kernel.radius; dx <= kernel.radius; ++dx) {
+      const double distance = std::hypot(dx, dy) * options.cell_size;
+      if (distance > options.cutoff) continue;
+      kernel.values[(dy + kernel.radius) * side + dx + kernel.radius] =
+          static_cast<std::uint8_t>(std::lround(255.0 * std::exp(-distance * distance * inv_two_sigma_sq)));
+    }
+  }
+  return kernel;
 }
 
-void LookupTable::buildKernel() {
-  // The stamp around one reference point, precomputed once: the value of a cell is the likelihood of
-  // the distance from the reference point's cell centre to this cell's centre.
-  const double reach = options_.kind == TableKind::kGraded ? options_.cutoff : options_.sigma;
-  kernel_radius_ = static_cast<int>(std::ceil(reach * inv_cell_size_ - 1e-9));
+LookupTableOptions LookupTable::validated(LookupTableOptions options) {
+  // Guard against nonsense sizes here too; the ROS layer validates and names the parameter.
+  if (!(options.cell_size > 1e-4)) options.cell_size = LookupTableOptions().cell_size;
+  if (!(options.sigma > 0.0)) options.sigma = LookupTableOptions().sigma;
+  if (!(options.cutoff >= options.cell_size)) options.cutoff = std::max(options.cell_size, 3 * options.sigma);
+  return options;
+}
+
+LookupTable::LookupTable(const LookupTableOptions& options, TableKernelFunction kernel)
+    : options_(validated(options)), inv_cell_size_(1.0 / options_.cell_size) {
+  TableKernel stamp = kernel ? kernel(options_) : gradedKernel(options_);
+  const auto side = static_cast<std::size_t>(2 * stamp.radius + 1);
+  if (stamp.radius < 0 || stamp.values.size() != side * side) stamp = gradedKernel(options_);
+  setKernel(stamp);
+}
+
+void LookupTable::setKernel(const TableKernel& kernel) {
+  // The stamp around one reference point, precomputed once.
+  kernel_radius_ = kernel.radius;
   const int side = 2 * kernel_radius_ + 1;
   // Rows padded with zeros (and the last one followed by zeros) for the stamps' 16-byte reads.
   kernel_stride_ = side + kChunk;
   kernel_.assign(static_cast<std::size_t>(kernel_stride_) * side + kChunk, 0);
-  const double inv_two_sigma_sq = 1.0 / (2.0 * options_.sigma * options_.sigma);
-  for (int dy = -kernel_radius_; dy <= kernel_radius_; ++dy) {
-    for (int dx = -kernel_radius_; dx <= kernel_radius_; ++dx) {
-      std::uint8_t value = 0;
-      if (options_.kind == TableKind::kGraded) {
-        const double distance = std::hypot(dx, dy) * options_.cell_size;
-        if (distance <= options_.cutoff) {
-          value = static_cast<std::uint8_t>(
-              std::lround(255.0 * std::exp(-distance * distance * inv_two_sigma_sq)));
-        }
-      } else {
-        value = 1;  // the whole square
-      }
-      kernel_[(dy + kernel_radius_) * kernel_stride_ + dx + kernel_radius_] = value;
-    }
+  for (int row = 0; row < side; ++row) {
+    std::copy_n(&kernel.values[static_cast<std::size_t>(row) * side], side, &kernel_[row * kernel_stride_]);
   }
+  const auto largest = std::max_element(kernel.values.begin(), kernel.values.end());
+  max_cell_value_ = std::max<std::uint32_t>(1, *largest);
   kernel_spans_.assign(static_cast<std::size_t>(side), {0, 0});
   for (int row = 0; row < side; ++row) {
     const std::uint8_t* values = &kernel_[static_cast<std::size_t>(row) * kernel_stride_];
@@ -96,8 +107,6 @@ void LookupTable::buildKernel() {
     --kernel_rows_.second;
   }
 }
-
-std::uint32_t LookupTable::maxCellValue() const { return options_.kind == TableKind::kGraded ? 255u : 1u; }
 
 std::size_t LookupTable::memoryBytes() const {
   return tile_offset_.capacity() * sizeof(std::int32_t) + tile_cells_.capacity() +
@@ -377,7 +386,7 @@ std::uint8_t LookupTable::valueInTable(const Eigen::Vector2d& point) const {
 int LookupTable::beamsThroughSurfaces(const std::vector<Eigen::Vector2d>& points, const Pose2D& sensor,
                                       double margin) const {
   if (tiles_in_use_ == 0 || !sensor.isFinite()) return 0;
-  // Steps of one cell: a graded surface's band (value >= max / 2) is 2.4 sigma wide, a binary one a cell.
+  // Steps of one cell: a graded surface's band (value >= max / 2) is 2.4 sigma wide.
   const double step = 1.0 / inv_cell_size_;
   const auto surface = static_cast<std::uint8_t>(std::max<std::uint32_t>(1, maxCellValue() / 2));
   // In the table's own frame; a beam is walked only where it crosses the table's extent (a wild reading

@@ -208,8 +208,7 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   // A prediction in doubt: the preset's whole box is searched under the second hypothesis.
   std::vector<Pose2D> wide_population;
   std::function<MatchCandidate()> search_wide;
-  if (prior.informative && usesGeneticStage(options_.matcher.algorithm) &&
-      leap_detector_.inDoubt(tight, h, fitness_)) {
+  if (prior.informative && leap_detector_.inDoubt(tight, h, fitness_)) {
     search_wide = [&] {
       const MatchResult match = matcher_.match(
           scan, h.prior.mean, population_out ? &wide_population : nullptr, &wide_search, &h.wide_prior);
@@ -383,9 +382,7 @@ void OdometryTracker::addKeyframe(const Scan& scan, TrackerUpdate* update) {
   const Pose2D old_frame = local_map_.frame();
   const auto start = std::chrono::steady_clock::now();
   local_map_.add(pose_ * laser_mount_, scan.points);
-  if (local_map_.tableCount() >= 2) {
-    matcher_.useTables(&local_map_.table(kFineTable), &local_map_.table(kCoarseTable));
-  }
+  matcher_.useTables(&local_map_.table(kFineTable), &local_map_.table(kCoarseTable));
   matcher_.extendReference(local_map_.reference(), local_map_.unchangedScans());
   update->diagnostics.table_build_ms = millisecondsSince(start);
   update->new_keyframe = true;

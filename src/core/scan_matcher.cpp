@@ -10,59 +10,7 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-TableKind tableKindOf(Algorithm algorithm) {
-  return algorithm == Algorithm::kHglasmBinary || algorithm == Algorithm::kGlasmBinary ? TableKind::kBinary
-                                                                                       : TableKind::kGraded;
-}
-
-LookupTableOptions tableOptionsFor(const LookupTableOptions& base, Algorithm algorithm) {
-  LookupTableOptions table = base;
-  table.kind = tableKindOf(algorithm);
-  return table;
-}
-
 }  // namespace
-
-const char* toString(Algorithm algorithm) {
-  switch (algorithm) {
-    case Algorithm::kHglasmG:
-      return "hglasm_g";
-    case Algorithm::kHglasmBinary:
-      return "hglasm_binary";
-    case Algorithm::kGlasmG:
-      return "glasm_g";
-    case Algorithm::kGlasmBinary:
-      return "glasm_binary";
-    case Algorithm::kMbicp:
-      return "mbicp";
-    case Algorithm::kPga:
-      return "pga";
-    case Algorithm::kHpga:
-      return "hpga";
-  }
-  return "unknown";
-}
-
-bool parseAlgorithm(const std::string& name, Algorithm* algorithm) {
-  for (Algorithm candidate :
-       {Algorithm::kHglasmG, Algorithm::kHglasmBinary, Algorithm::kGlasmG, Algorithm::kGlasmBinary,
-        Algorithm::kMbicp, Algorithm::kPga, Algorithm::kHpga}) {
-    if (name == toString(candidate)) {
-      *algorithm = candidate;
-      return true;
-    }
-  }
-  return false;
-}
-
-bool usesGeneticStage(Algorithm algorithm) { return algorithm != Algorithm::kMbicp; }
-bool usesMbicpStage(Algorithm algorithm) {
-  return algorithm == Algorithm::kHglasmG || algorithm == Algorithm::kHglasmBinary ||
-         algorithm == Algorithm::kMbicp || algorithm == Algorithm::kHpga;
-}
-bool usesPolarPairing(Algorithm algorithm) {
-  return algorithm == Algorithm::kPga || algorithm == Algorithm::kHpga;
-}
 
 const char* toString(Preset preset) {
   switch (preset) {
@@ -112,9 +60,6 @@ MatcherOptions presetOptions(Preset preset) {
       options.coarse_table.cutoff = 1.20;
       break;
   }
-  // PGA pairs within the reach of GLASM's tables: the fine table's cut-off, then the coarse one's.
-  options.pga.pairing_threshold = options.table.cutoff;
-  options.pga.coarse_pairing_threshold = options.coarse_table.cutoff;
   return options;
 }
 
@@ -136,50 +81,11 @@ const char* toString(MatchStatus status) {
   return "unknown";
 }
 
-ScanMatcher::ScanMatcher(const MatcherOptions& options)
-    : options_(options),
-      table_(tableOptionsFor(options.table, options.algorithm)),
-      coarse_table_(tableOptionsFor(options.coarse_table, options.algorithm)),
-      aligner_(options.genetic),
-      mbicp_(options.mbicp),
-      polar_pairing_(options.pga) {}
-
-void ScanMatcher::setReference(const Scan& reference) {
-  ReferencePoints single;
-  single.append(reference.points);
-  setReference(single);
-}
-
-void ScanMatcher::setReference(const ReferencePoints& reference) {
-  const auto start = std::chrono::steady_clock::now();
-  if (usesPolarPairing(options_.algorithm)) {
-    polar_pairing_.build(reference);  // PGA's preparation: sorting the reference by angle
-  } else if (usesGeneticStage(options_.algorithm) && !external_fine_) {
-    table_.build(reference);
-    reference_ = reference;
-    coarse_table_stale_ = true;
-  }
-  table_build_ms_ = millisecondsSince(start);
-  mbicp_.setReference(reference);
-  has_reference_ = !reference.empty();
-}
-
-void ScanMatcher::extendReference(const ReferencePoints& reference, std::size_t first_new_scan) {
-  if (first_new_scan == 0 || !external_fine_ || usesPolarPairing(options_.algorithm)) {
-    setReference(reference);
-    return;
-  }
-  const auto start = std::chrono::steady_clock::now();
-  mbicp_.extendReference(reference, first_new_scan);
-  table_build_ms_ = millisecondsSince(start);
-  has_reference_ = !reference.empty();
-}
-
-bool ScanMatcher::startResult(const Scan& scan, const Pose2D& guess, MatchResult* result) const {
+bool startMatch(bool has_reference, const Scan& scan, const Pose2D& guess, MatchResult* result) {
   result->pose = result->prealigned_pose = guess.isFinite() ? guess : Pose2D();
   // Without a trustworthy estimate the covariance says so (finite, large).
   result->covariance = Eigen::Matrix3d::Identity() * 1e4;
-  if (!has_reference_) {
+  if (!has_reference) {
     result->status = MatchStatus::kNoReference;
     return false;
   }
@@ -190,53 +96,14 @@ bool ScanMatcher::startResult(const Scan& scan, const Pose2D& guess, MatchResult
   return true;
 }
 
-MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vector<Pose2D>* population_out,
-                               const SearchEffort* effort, const PosePrior* prior) {
-  MatchResult result;
-  if (!startResult(scan, guess, &result)) return result;
-  const Pose2D start_pose = result.pose;
-
-  coarse_table_build_ms_ = 0.0;
-  if (usesGeneticStage(options_.algorithm)) {
-    const auto start = std::chrono::steady_clock::now();
-    const int coarse_generations = effort ? effort->coarse_generations : options_.genetic.coarse_generations;
-    const bool polar = usesPolarPairing(options_.algorithm);
-    if (!polar && !external_coarse_ && coarse_generations > 0 && coarse_table_stale_) {
-      coarse_table_.build(reference_);
-      coarse_table_stale_ = false;
-      coarse_table_build_ms_ = millisecondsSince(start);
-    }
-    PreAlignResult prealigned;
-    if (polar) {
-      pga_points_.assign(aligner_.fitnessSubset(scan.points));
-      const FitnessStages stages = polarPairingStages(polar_pairing_, pga_points_, options_.table.cell_size);
-      prealigned = aligner_.align(stages, start_pose, population_out, effort);
-    } else {
-      prealigned =
-          aligner_.align(fineTable(), scan.points, start_pose, population_out, &coarseTable(), effort);
-    }
-    result.prealign_ms = millisecondsSince(start);
-    result.prealigned_pose = result.pose = prealigned.pose;
-    result.prealigned_fitness = prealigned.fitness;
-    result.prealigned_fitness_ratio = prealigned.fitness_ratio;
-    result.evaluations = prealigned.evaluations;
-    if (!usesMbicpStage(options_.algorithm)) {
-      result.status = prealigned.fitness > 0 ? MatchStatus::kOk : MatchStatus::kLowFitness;
-      // The GA's own precision: about one sigma of the lookup kernel in translation.
-      const double sigma = options_.table.sigma;
-      result.covariance = Eigen::Vector3d(sigma * sigma, sigma * sigma, 0.02 * 0.02).asDiagonal();
-      return result;
-    }
-  }
-
-  refineInto(scan, prior, &result);
-  return result;
+void applyPrealignment(const PreAlignResult& prealigned, MatchResult* result) {
+  result->prealigned_pose = result->pose = prealigned.pose;
+  result->prealigned_fitness = prealigned.fitness;
+  result->prealigned_fitness_ratio = prealigned.fitness_ratio;
+  result->evaluations = prealigned.evaluations;
 }
 
-void ScanMatcher::refineInto(const Scan& scan, const PosePrior* prior, MatchResult* result) {
-  const auto start = std::chrono::steady_clock::now();
-  const MbicpResult refined = mbicp_.match(scan, result->prealigned_pose, prior);
-  result->refine_ms = millisecondsSince(start);
+void applyRefinement(const MbicpResult& refined, MatchResult* result) {
   result->pose = refined.pose;
   result->iterations = refined.iterations;
   result->associations = refined.associations;
@@ -261,9 +128,72 @@ void ScanMatcher::refineInto(const Scan& scan, const PosePrior* prior, MatchResu
   }
 }
 
+ScanMatcher::ScanMatcher(const MatcherOptions& options)
+    : options_(options),
+      table_(options.table),
+      coarse_table_(options.coarse_table),
+      aligner_(options.genetic),
+      mbicp_(options.mbicp) {}
+
+void ScanMatcher::setReference(const Scan& reference) {
+  ReferencePoints single;
+  single.append(reference.points);
+  setReference(single);
+}
+
+void ScanMatcher::setReference(const ReferencePoints& reference) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!external_fine_) {
+    table_.build(reference);
+    reference_ = reference;
+    coarse_table_stale_ = true;
+  }
+  table_build_ms_ = millisecondsSince(start);
+  mbicp_.setReference(reference);
+  has_reference_ = !reference.empty();
+}
+
+void ScanMatcher::extendReference(const ReferencePoints& reference, std::size_t first_new_scan) {
+  if (first_new_scan == 0 || !external_fine_) {
+    setReference(reference);
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  mbicp_.extendReference(reference, first_new_scan);
+  table_build_ms_ = millisecondsSince(start);
+  has_reference_ = !reference.empty();
+}
+
+MatchResult ScanMatcher::match(const Scan& scan, const Pose2D& guess, std::vector<Pose2D>* population_out,
+                               const SearchEffort* effort, const PosePrior* prior) {
+  MatchResult result;
+  if (!startMatch(has_reference_, scan, guess, &result)) return result;
+  coarse_table_build_ms_ = 0.0;
+  const auto start = std::chrono::steady_clock::now();
+  const int coarse_generations = effort ? effort->coarse_generations : options_.genetic.coarse_generations;
+  if (!external_coarse_ && coarse_generations > 0 && coarse_table_stale_) {
+    coarse_table_.build(reference_);
+    coarse_table_stale_ = false;
+    coarse_table_build_ms_ = millisecondsSince(start);
+  }
+  const PreAlignResult prealigned =
+      aligner_.align(fineTable(), scan.points, result.pose, population_out, &coarseTable(), effort);
+  result.prealign_ms = millisecondsSince(start);
+  applyPrealignment(prealigned, &result);
+  refineInto(scan, prior, &result);
+  return result;
+}
+
+void ScanMatcher::refineInto(const Scan& scan, const PosePrior* prior, MatchResult* result) {
+  const auto start = std::chrono::steady_clock::now();
+  const MbicpResult refined = mbicp_.match(scan, result->prealigned_pose, prior);
+  result->refine_ms = millisecondsSince(start);
+  applyRefinement(refined, result);
+}
+
 MatchResult ScanMatcher::refine(const Scan& scan, const Pose2D& guess, const PosePrior* prior) {
   MatchResult result;
-  if (!startResult(scan, guess, &result)) return result;
+  if (!startMatch(has_reference_, scan, guess, &result)) return result;
   refineInto(scan, prior, &result);
   return result;
 }

@@ -139,7 +139,7 @@ bool usableStatus(MatchStatus status) {
 
 // `prealign_only`: judge the GA's pose with the pre-alignment thresholds (curves); otherwise the final
 // pose with the thresholds of the algorithm.
-TrialOutcome runTrial(ScanMatcher* matcher, const TrialPair& pair, const SuccessThresholds& thresholds,
+TrialOutcome runTrial(BaselineMatcher* matcher, const TrialPair& pair, const SuccessThresholds& thresholds,
                       bool prealign_only) {
   matcher->reseed(pair.ga_seed);
   const auto start = std::chrono::steady_clock::now();
@@ -151,7 +151,7 @@ TrialOutcome runTrial(ScanMatcher* matcher, const TrialPair& pair, const Success
   outcome.ms = std::chrono::duration<double, std::milli>(stop - start).count();
   outcome.preparation_ms = matcher->lastTableBuildMs() + matcher->lastCoarseTableBuildMs();
   outcome.evaluations = result.evaluations;
-  const Algorithm algorithm = matcher->options().algorithm;
+  const Algorithm algorithm = matcher->algorithm();
   const bool judge_prealigned = prealign_only || !usesMbicpStage(algorithm);
   const Pose2D estimate = prealign_only ? result.prealigned_pose : result.pose;
   outcome.failed_status = !usableStatus(result.status);
@@ -198,7 +198,7 @@ struct Tally {
   double ratio() const { return trials > 0 ? static_cast<double>(successes) / trials : 0.0; }
 };
 
-Tally runTrials(ScanMatcher* matcher, const std::vector<TrialPair>& pairs,
+Tally runTrials(BaselineMatcher* matcher, const std::vector<TrialPair>& pairs,
                 const SuccessThresholds& thresholds, bool prealign_only) {
   Tally tally;
   for (const TrialPair& pair : pairs) tally.add(runTrial(matcher, pair, thresholds, prealign_only));
@@ -371,7 +371,7 @@ UsableScans usableScans(const std::vector<RangeScan>& scans, const SuccessRatioO
 }
 
 using MatcherKey = std::pair<Algorithm, Preset>;
-using Matchers = std::map<MatcherKey, std::unique_ptr<ScanMatcher>>;
+using Matchers = std::map<MatcherKey, std::unique_ptr<BaselineMatcher>>;
 
 struct ProgressState {
   SuccessRatioProgress state;
@@ -413,10 +413,9 @@ void runCurves(const std::vector<RangeScan>& scans, const UsableScans& usable,
         boxPairs(scans, usable, options, base.genetic.box, options.curve_trials);
     for (Algorithm algorithm : options.curve_algorithms) {
       for (int generations : curveGenerations(options, base.genetic.generations)) {
-        MatcherOptions matcher_options = base;
-        matcher_options.algorithm = algorithm;
-        matcher_options.genetic.generations = generations;
-        ScanMatcher matcher(matcher_options);
+        BaselineOptions matcher_options = baselineOptions(algorithm, preset);
+        matcher_options.matcher.genetic.generations = generations;
+        BaselineMatcher matcher(matcher_options);
         const Tally tally = runTrials(&matcher, pairs, options.thresholds, true);
         const EvaluationCurvePoint point = curvePoint(algorithm, preset, base.genetic, generations, tally);
         report->curve.push_back(point);
@@ -525,9 +524,7 @@ bool runSuccessRatio(const std::vector<RangeScan>& scans, const SuccessRatioOpti
   Matchers matchers;
   for (Algorithm algorithm : options.algorithms) {
     for (Preset preset : options.presets) {
-      MatcherOptions matcher_options = presetOptions(preset);
-      matcher_options.algorithm = algorithm;
-      matchers[{algorithm, preset}] = std::make_unique<ScanMatcher>(matcher_options);
+      matchers[{algorithm, preset}] = std::make_unique<BaselineMatcher>(baselineOptions(algorithm, preset));
     }
   }
 

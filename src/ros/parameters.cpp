@@ -202,11 +202,12 @@ class ParamTree : public OptionVisitor<ParamTree> {
     *out = name;
   }
 
-  void algorithm(const std::string& path, hglasm::Algorithm* out) {
-    std::string name;
-    if (string(path, &name) && !hglasm::parseAlgorithm(name, out)) {
-      fail(path, "one of hglasm_g, hglasm_binary, glasm_g, glasm_binary, mbicp, pga, hpga", describe(name));
-    }
+  /// A parameter that was removed: set at all, it is an error saying so (`why`: what to do instead).
+  void removed(const std::string& path, const std::string& why) {
+    XmlRpcValue value;
+    if (!find(path, &value) || failed_) return;
+    failed_ = true;
+    if (error_) *error_ = "parameter " + prefix_ + path + " (" + describe(value) + ") was removed: " + why;
   }
 
   /// "auto" (learned from the matches) or a fixed number of seconds within +-kMaxFixedTimeOffset.
@@ -277,9 +278,6 @@ class ParamWriter : public OptionVisitor<ParamWriter> {
   void boolean(const std::string& path, bool* value) { set(path, XmlRpcValue(*value)); }
   void frame(const std::string& path, std::string* value) { set(path, XmlRpcValue(*value)); }
   void topic(const std::string& path, std::string* value) { set(path, XmlRpcValue(*value)); }
-  void algorithm(const std::string& path, hglasm::Algorithm* value) {
-    set(path, XmlRpcValue(std::string(hglasm::toString(*value))));
-  }
   void timeOffset(const std::string& path, hglasm::TimeOffsetOptions* value) {
     set(path, value->estimate ? XmlRpcValue(std::string("auto")) : XmlRpcValue(value->offset));
   }
@@ -476,7 +474,6 @@ void visitMbicpOptions(Params& tree, hglasm::MbicpOptions* options) {
 /// written (ParamWriter). The one list of the parameters.
 template <typename Params>
 void visitOptions(Params& tree, LaserOdometryOptions* options) {
-  tree.algorithm("algorithm", &options->tracker.matcher.algorithm);
   visitNodeOptions(tree, options);
   visitTrackerOptions(tree, &options->tracker);
   visitPredictionOptions(tree, options);
@@ -537,6 +534,11 @@ bool checkConsistency(const LaserOdometryOptions& options, std::string* error) {
   return true;
 }
 
+/// ~algorithm chose among the papers' matchers; a baseline is no longer what the odometry can run.
+constexpr const char* kAlgorithmRemoved =
+    "the odometry always runs hglasm_g; the papers' other algorithms are compared by the success_ratio tool "
+    "(--algorithms); delete the parameter";
+
 /// What a user is told of a parameter nobody reads: a retired one says what replaced it.
 std::string unknownParameterWarning(const std::string& path) {
   if (path == "~max_time_jump") {
@@ -588,6 +590,7 @@ bool applyPresetTree(const XmlRpcValue& preset_tree, LaserOdometryOptions* optio
   std::string preset_error;
   ParamTree preset_params(preset_tree, prefix + "/", &preset_error);
   visitOptions(preset_params, options);
+  preset_params.removed("algorithm", kAlgorithmRemoved);
   if (preset_params.failed()) {
     if (error) *error = preset_error;
     return false;
@@ -623,6 +626,7 @@ bool loadOptions(const XmlRpcValue& private_params, LaserOdometryOptions* option
 
   // Layer 3: the top level (config/laser_odometry.yaml, single overrides).
   visitOptions(top, options);
+  top.removed("algorithm", kAlgorithmRemoved);
   if (top.failed()) {
     if (error) *error = top_error;
     return false;
@@ -656,12 +660,11 @@ std::string summarize(const LaserOdometryOptions& options) {
   const hglasm::MatcherOptions& matcher = options.tracker.matcher;
   const hglasm::GeneticOptions& genetic = matcher.genetic;
   std::ostringstream out;
-  out << "preset " << options.preset << ", algorithm " << hglasm::toString(matcher.algorithm) << ", box +-"
-      << genetic.box.half_x << " m x +-" << genetic.box.half_y << " m x +-" << genetic.box.half_theta
-      << " rad, GA " << genetic.population << "x" << genetic.generations << "x" << genetic.runs << ", cell "
-      << matcher.table.cell_size << " m, keyframe " << options.tracker.keyframe.distance << " m / "
-      << options.tracker.keyframe.angle << " rad, " << options.odom_frame << " -> " << options.base_frame
-      << (options.publish_tf ? " (tf)" : " (no tf)")
+  out << "preset " << options.preset << ", box +-" << genetic.box.half_x << " m x +-" << genetic.box.half_y
+      << " m x +-" << genetic.box.half_theta << " rad, GA " << genetic.population << "x"
+      << genetic.generations << "x" << genetic.runs << ", cell " << matcher.table.cell_size << " m, keyframe "
+      << options.tracker.keyframe.distance << " m / " << options.tracker.keyframe.angle << " rad, "
+      << options.odom_frame << " -> " << options.base_frame << (options.publish_tf ? " (tf)" : " (no tf)")
       << (options.tracker.prediction.use_odometry ? ", wheel odometry in" : ", no wheel odometry")
       << (options.tracker.prediction.use_imu
               ? (options.tracker.prediction.imu.use_orientation ? ", IMU orientation in" : ", IMU rate in")

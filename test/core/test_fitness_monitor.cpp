@@ -1,5 +1,5 @@
-// One yardstick for every algorithm: the tables a local map keeps and the one scans are judged on, a scan's
-// fitness ratio and likelihoods on it, and the running statistics of how well matches usually fit.
+// The tables a local map keeps and the one scans are judged on, a scan's fitness ratio and likelihoods on
+// it, and the running statistics of how well matches usually fit.
 #include "hglasm_odometry/core/fitness_monitor.h"
 
 #include <gtest/gtest.h>
@@ -10,45 +10,26 @@
 
 namespace {
 
-using hglasm::Algorithm;
 using hglasm::FitnessMonitor;
 using hglasm::Pose2D;
-using hglasm::TableKind;
 
-hglasm::MatcherOptions matcherWith(Algorithm algorithm) {
-  hglasm::MatcherOptions options;
-  options.algorithm = algorithm;
-  return options;
+TEST(FitnessMonitor, MapTablesAreTheGasFineAndCoarseTables) {
+  hglasm::MatcherOptions matcher;
+  matcher.table.cell_size = 0.03;
+  const auto tables = hglasm::mapTables(matcher);
+  ASSERT_EQ(tables.size(), 2u);
+  EXPECT_EQ(tables[hglasm::kFineTable].cell_size, 0.03);
+  EXPECT_EQ(tables[hglasm::kCoarseTable].cell_size, hglasm::coarseTableOptions().cell_size);
 }
 
-TEST(FitnessMonitor, MapTablesAddAGradedJudgingTableOnlyWhereTheGaHasNone) {
-  const auto graded = hglasm::mapTables(matcherWith(Algorithm::kHglasmG));
-  ASSERT_EQ(graded.size(), 2u);
-  EXPECT_EQ(graded[0].kind, TableKind::kGraded);
-  EXPECT_EQ(graded[1].kind, TableKind::kGraded);
-  EXPECT_EQ(graded[1].cell_size, hglasm::coarseTableOptions().cell_size) << "the coarse table second";
-  const auto binary = hglasm::mapTables(matcherWith(Algorithm::kHglasmBinary));
-  ASSERT_EQ(binary.size(), 3u);
-  EXPECT_EQ(binary[0].kind, TableKind::kBinary);
-  EXPECT_EQ(binary[1].kind, TableKind::kBinary);
-  EXPECT_EQ(binary[2].kind, TableKind::kGraded);
-  for (Algorithm alone : {Algorithm::kMbicp, Algorithm::kPga}) {
-    const auto tables = hglasm::mapTables(matcherWith(alone));
-    ASSERT_EQ(tables.size(), 1u) << hglasm::toString(alone);
-    EXPECT_EQ(tables[0].kind, TableKind::kGraded) << hglasm::toString(alone);
-  }
-}
-
-TEST(FitnessMonitor, TheJudgingTableIsTheGradedOne) {
-  for (Algorithm algorithm : {Algorithm::kHglasmG, Algorithm::kHglasmBinary, Algorithm::kMbicp}) {
-    hglasm::LocalMap map({}, hglasm::mapTables(matcherWith(algorithm)));
-    map.add(Pose2D(), {Eigen::Vector2d(2.0, 0.0), Eigen::Vector2d(2.0, 0.05)});
-    const hglasm::LookupTable& judging = hglasm::judgingTable(map);
-    EXPECT_EQ(judging.options().kind, TableKind::kGraded) << hglasm::toString(algorithm);
-    EXPECT_EQ(judging.options().cell_size, hglasm::LookupTableOptions().cell_size)
-        << hglasm::toString(algorithm);
-    EXPECT_FALSE(judging.empty());
-  }
+TEST(FitnessMonitor, TheJudgingTableIsTheFineOne) {
+  hglasm::LocalMap map({}, hglasm::mapTables(hglasm::MatcherOptions()));
+  map.add(Pose2D(), {Eigen::Vector2d(2.0, 0.0), Eigen::Vector2d(2.0, 0.05)});
+  const hglasm::LookupTable& judging = hglasm::judgingTable(map);
+  EXPECT_EQ(&judging, &map.table(hglasm::kFineTable));
+  EXPECT_EQ(judging.options().cell_size, hglasm::LookupTableOptions().cell_size);
+  EXPECT_EQ(judging.maxCellValue(), 255u);
+  EXPECT_FALSE(judging.empty());
 }
 
 TEST(FitnessMonitor, LikelihoodWeightCountsTheIndependentPointsOverTheEvidenceScale) {

@@ -38,10 +38,9 @@ bool prealigned(const Pose2D& estimate, const Pose2D& truth) {
 /// the world, which is then also the reference frame).
 class RoomFixture {
  public:
-  explicit RoomFixture(const LaserSpec& laser, hglasm::TableKind kind = hglasm::TableKind::kGraded)
+  explicit RoomFixture(const LaserSpec& laser)
       : world_(hglasm_test::room()),
         laser_(laser),
-        table_(tableOptions(kind)),
         coarse_table_(hglasm::presetOptions(hglasm::Preset::kLarge).coarse_table) {
     reference_ = hglasm_test::simulateScan(world_, Pose2D(), laser_);
     table_.build(reference_.points);
@@ -53,11 +52,6 @@ class RoomFixture {
   const LookupTable* coarse() const { return &coarse_table_; }
 
  private:
-  static hglasm::LookupTableOptions tableOptions(hglasm::TableKind kind) {
-    hglasm::LookupTableOptions options;
-    options.kind = kind;
-    return options;
-  }
   hglasm_test::World world_;
   LaserSpec laser_;
   LookupTable table_;
@@ -347,19 +341,6 @@ TEST(GeneticAligner, TheBoxIsCentredOnTheGuess) {
     if (prealigned(near.pose, truth)) ++found_near_guess;
   }
   EXPECT_GE(found_near_guess, 4);
-}
-
-TEST(GeneticAligner, BinaryTableAlsoPrealignsAModestError) {
-  // Both table kinds drive the same GA: a binary table also pre-aligns a modest error.
-  const RoomFixture room(hglasm_test::halfCircleLaser(), hglasm::TableKind::kBinary);
-  const Pose2D truth(0.15, -0.1, 0.1);
-  GeneticOptions options = presetGenetic(hglasm::Preset::kMedium, 4);
-  options.max_points = 0;  // fitness over all points
-  GeneticAligner aligner(options);
-  const PreAlignResult result = aligner.align(room.table(), room.scanAt(truth).points, Pose2D());
-  EXPECT_TRUE(prealigned(result.pose, truth))
-      << result.pose.x << " " << result.pose.y << " " << result.pose.theta;
-  EXPECT_EQ(result.fitness, room.table().fitness(room.scanAt(truth).points, result.pose));
 }
 
 TEST(GeneticAligner, EmptyInputsGiveFiniteResults) {

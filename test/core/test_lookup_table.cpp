@@ -1,5 +1,5 @@
 // GLASM lookup tables: graded values (normal in the distance to the nearest reference point), cut-off,
-// the binary square, sparse memory, and fitness.
+// another stamp given as a kernel, sparse memory, and fitness.
 #include "hglasm_odometry/core/lookup_table.h"
 
 #include <gtest/gtest.h>
@@ -14,7 +14,6 @@ namespace {
 
 using hglasm::LookupTable;
 using hglasm::LookupTableOptions;
-using hglasm::TableKind;
 using Points = std::vector<Eigen::Vector2d>;
 
 constexpr double kCell = 0.02;
@@ -25,18 +24,11 @@ constexpr double kCutoff = 0.30;
 /// footprints).
 LookupTableOptions gradedOptions() {
   LookupTableOptions options;
-  options.kind = TableKind::kGraded;
   options.cell_size = kCell;
   options.sigma = kSigma;
   options.cutoff = kCutoff;
   options.segment_max_gap = 0.0;
   options.isolated_footprint = 0.0;
-  return options;
-}
-
-LookupTableOptions binaryOptions() {
-  LookupTableOptions options = gradedOptions();
-  options.kind = TableKind::kBinary;
   return options;
 }
 
@@ -138,26 +130,42 @@ TEST(LookupTable, SegmentsJoinCloseConsecutivePointsOnly) {
   EXPECT_LT(reordered.valueAt(a + Eigen::Vector2d(6 * kCell, 0.0)), 250);
 }
 
-TEST(LookupTable, BinaryTableIsASquareOfOnes) {
-  LookupTable table(binaryOptions());
-  table.build({kCentre});
-  EXPECT_EQ(table.maxCellValue(), 1u);
-  EXPECT_EQ(table.valueAt(kCentre), 1);
-  const int half_side_cells = static_cast<int>(std::lround(kSigma / kCell));  // header: half-side sigma
-  // The corners of the square are inside (a square, not a disc) ...
-  for (int sx : {-1, 1}) {
-    for (int sy : {-1, 1}) {
-      EXPECT_EQ(table.valueAt(kCentre + kCell * Eigen::Vector2d(sx * half_side_cells, sy * half_side_cells)),
-                1);
-      EXPECT_EQ(table.valueAt(kCentre + kCell * Eigen::Vector2d(sx * (half_side_cells + 1), 0.0)), 0);
-      EXPECT_EQ(table.valueAt(kCentre + kCell * Eigen::Vector2d(0.0, sy * (half_side_cells + 1))), 0);
-    }
+/// A plus of 7s, two cells long each way (a kernel the graded one is not).
+hglasm::TableKernel plusKernel(const LookupTableOptions&) {
+  hglasm::TableKernel kernel;
+  kernel.radius = 2;
+  kernel.values.assign(25, 0);
+  for (int i = 0; i < 5; ++i) kernel.values[2 * 5 + i] = kernel.values[i * 5 + 2] = 7;
+  return kernel;
+}
+
+hglasm::TableKernel wrongSizeKernel(const LookupTableOptions&) {
+  hglasm::TableKernel kernel;
+  kernel.radius = 2;
+  kernel.values.assign(24, 9);
+  return kernel;
+}
+
+TEST(LookupTable, AKernelFunctionReplacesTheGradedStamp) {
+  LookupTable plus(gradedOptions(), plusKernel);
+  plus.build({kCentre});
+  EXPECT_EQ(plus.maxCellValue(), 7u) << "the kernel's largest value";
+  for (int d = -2; d <= 2; ++d) {
+    EXPECT_EQ(plus.valueAt(kCentre + kCell * Eigen::Vector2d(d, 0.0)), 7) << d;
+    EXPECT_EQ(plus.valueAt(kCentre + kCell * Eigen::Vector2d(0.0, d)), 7) << d;
   }
-  // ... and every cell inside holds exactly 1.
-  for (int dx = -half_side_cells; dx <= half_side_cells; ++dx) {
-    for (int dy = -half_side_cells; dy <= half_side_cells; ++dy) {
-      ASSERT_EQ(table.valueAt(kCentre + kCell * Eigen::Vector2d(dx, dy)), 1) << dx << " " << dy;
-    }
+  EXPECT_EQ(plus.valueAt(kCentre + kCell * Eigen::Vector2d(1.0, 1.0)), 0);
+  EXPECT_EQ(plus.valueAt(kCentre + kCell * Eigen::Vector2d(3.0, 0.0)), 0);
+  EXPECT_EQ(plus.fitness(Points{kCentre}, hglasm::Pose2D()), 7u);
+  // A kernel of the wrong size is not trusted: the graded stamp instead.
+  LookupTable fallback(gradedOptions(), wrongSizeKernel);
+  fallback.build({kCentre});
+  LookupTable graded(gradedOptions());
+  graded.build({kCentre});
+  EXPECT_EQ(fallback.maxCellValue(), 255u);
+  for (int d = 0; d <= 16; ++d) {
+    const Eigen::Vector2d at = kCentre + kCell * Eigen::Vector2d(d, 0.5 * d);
+    EXPECT_EQ(fallback.valueAt(at), graded.valueAt(at)) << d;
   }
 }
 
@@ -169,9 +177,6 @@ TEST(LookupTable, FitnessOfTheReferenceItselfIsTheMaximum) {
   LookupTable graded(gradedOptions());
   graded.build(scan.points);
   EXPECT_EQ(graded.fitness(scan.points, hglasm::Pose2D()), 255u * scan.size());
-  LookupTable binary(binaryOptions());
-  binary.build(scan.points);
-  EXPECT_EQ(binary.fitness(scan.points, hglasm::Pose2D()), scan.size());
   // A displaced copy fits less.
   EXPECT_LT(graded.fitness(scan.points, hglasm::Pose2D(0.05, 0.0, 0.0)), 255u * scan.size());
   EXPECT_LT(graded.fitness(scan.points, hglasm::Pose2D(0.0, 0.0, 0.05)), 255u * scan.size());

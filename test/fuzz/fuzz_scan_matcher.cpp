@@ -1,5 +1,6 @@
-// libFuzzer target: arbitrary bytes -> two RangeScans (+ a guess and options) -> conversion, matching
-// and tracking. Asserts what the package promises for any input: no crash, finite outputs.
+// libFuzzer target: arbitrary bytes -> two RangeScans (+ a guess and options) -> conversion, matching (the
+// odometry's matcher and the evaluation's baselines) and tracking. Asserts what the package promises for
+// any input: no crash, finite outputs.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -8,6 +9,7 @@
 
 #include "hglasm_odometry/core/odometry_tracker.h"
 #include "hglasm_odometry/core/scan_matcher.h"
+#include "hglasm_odometry/evaluation/baseline_matcher.h"
 
 namespace {
 
@@ -64,8 +66,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   ByteReader reader(data, size);
   const std::uint8_t selector = reader.take<std::uint8_t>();
   const hglasm::Preset preset = static_cast<hglasm::Preset>(selector % 3);
-  hglasm::MatcherOptions options = hglasm::presetOptions(preset);
-  options.algorithm = static_cast<hglasm::Algorithm>((selector / 3) % 7);  // PGA and HPGA included
+  const auto algorithm = static_cast<hglasm::Algorithm>((selector / 3) % 7);  // PGA and HPGA included
+  hglasm::BaselineOptions baseline = hglasm::baselineOptions(algorithm, preset);
+  hglasm::MatcherOptions& options = baseline.matcher;
   // Keep each run short: the fuzzer explores inputs, not GA sizes.
   options.genetic.population = 10;
   options.genetic.generations = 3;
@@ -86,6 +89,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   hglasm::ScanMatcher matcher(options);
   matcher.setReference(reference);
   checkFinite(matcher.match(scan, guess));
+  checkFinite(matcher.refine(scan, guess));
+  hglasm::BaselineMatcher compared(baseline);
+  compared.setReference(reference);
+  checkFinite(compared.match(scan, guess));
 
   // The tracker over the two scans, with odometry samples from the same bytes.
   hglasm::TrackerOptions tracker_options;

@@ -256,7 +256,6 @@ TEST(Parameters, WrongTypesNameTheParameterAndTheValue) {
       std::string::npos);
   EXPECT_NE(loadError(params({{"preset", 3}})).find("~preset must be a non-empty string, got 3"),
             std::string::npos);
-  EXPECT_NE(loadError(params({{"algorithm", "sift"}})).find("~algorithm"), std::string::npos);
   EXPECT_NE(loadError(params({{"base_frame", true}})).find("~base_frame"), std::string::npos);
   XmlRpcValue list;
   list[0] = 1;
@@ -335,11 +334,24 @@ TEST(Parameters, TheRetiredMaxTimeJumpSaysWhatReplacedIt) {
   EXPECT_NE(warnings[0].find("~time/reset_on_jump_back"), std::string::npos) << warnings[0];
 }
 
+TEST(Parameters, TheRemovedAlgorithmIsAnErrorThatSaysSo) {
+  // Any value, the odometry's own included: the setting no longer chooses anything.
+  for (const char* value : {"pga", "hglasm_g"}) {
+    const std::string error = loadError(params({{"algorithm", value}}));
+    EXPECT_EQ(error.find("parameter ~algorithm (string \"" + std::string(value) + "\") was removed"), 0u)
+        << error;
+    EXPECT_NE(error.find("success_ratio"), std::string::npos) << error;
+  }
+  const std::string in_preset =
+      loadError(params({{"preset", "small"}, {"presets/small/algorithm", "mbicp"}}));
+  EXPECT_EQ(in_preset.find("parameter ~presets/small/algorithm (string \"mbicp\") was removed"), 0u)
+      << in_preset;
+}
+
 TEST(Parameters, ToParamsIsWhatLoadOptionsReadsBack) {
   LaserOdometryOptions options;
   std::string error;
   ASSERT_TRUE(loadOptions(params({{"preset", "large"},
-                                  {"algorithm", "glasm_binary"},
                                   {"genetic/elite_count", 2},
                                   {"genetic/seed", 77},
                                   {"mbicp/point_to_line", false},
@@ -350,7 +362,7 @@ TEST(Parameters, ToParamsIsWhatLoadOptionsReadsBack) {
                           &options, &error))
       << error;
   XmlRpcValue written = toParams(options);
-  EXPECT_EQ(static_cast<std::string>(written["algorithm"]), "glasm_binary");
+  EXPECT_FALSE(written.hasMember("algorithm"));
   EXPECT_EQ(static_cast<int>(written["genetic"]["elite_count"]), 2);
   EXPECT_EQ(static_cast<bool>(written["use_odom"]), false);
   EXPECT_EQ(static_cast<std::string>(written["base_frame"]), "base");

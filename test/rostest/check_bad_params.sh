@@ -30,6 +30,7 @@ cases=(
   "negative_path_length|path_length: -1|~path_length"
   "negative_size_in_a_preset|presets: {medium: {genetic: {box_x: -1.0}}}|~presets/medium/genetic/box_x"
   "no_elites|genetic: {elite_count: 0}|~genetic/elite_count"
+  "removed_algorithm|algorithm: pga|~algorithm"
 )
 run_case() {  # name yaml -> sets rc, out
   local name="$1" yaml="$2"

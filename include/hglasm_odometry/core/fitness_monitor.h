@@ -1,6 +1,5 @@
-// How well a scan fits the local map, on one yardstick for every algorithm: the local map's fine graded
-// lookup table (the GA's own where it is graded, else a table kept for judging alone), read as a fitness
-// ratio or as a likelihood field; and how well accepted matches usually fit.
+// How well a scan fits the local map: on the local map's fine graded lookup table (the GA's own), read as a
+// fitness ratio or as a likelihood field; and how well accepted matches usually fit.
 #pragma once
 
 #include <cstddef>
@@ -14,13 +13,11 @@
 
 namespace hglasm {
 
-/// The lookup tables a local map keeps for `matcher`: the GA's fine and coarse table (of the algorithm's
-/// kind), then the graded table scans are judged on if the fine one is not it (binary tables; MbICP and PGA
-/// alone keep only that one).
+/// The lookup tables a local map keeps for `matcher`: the GA's fine and coarse table.
 std::vector<LookupTableOptions> mapTables(const MatcherOptions& matcher);
 constexpr std::size_t kFineTable = 0;  ///< indices of the GA's tables in mapTables()
 constexpr std::size_t kCoarseTable = 1;
-/// The table of `map` (its tables from mapTables()) that scans are judged on.
+/// The table of `map` (its tables from mapTables()) that scans are judged on: the fine one.
 const LookupTable& judgingTable(const LocalMap& map);
 
 /// A scan's likelihood weight: `independent_points` of its `points` count (the scan's information counts

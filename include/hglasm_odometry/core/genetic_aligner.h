@@ -69,8 +69,8 @@ struct PreAlignResult {
 /// Scores a candidate pose of the new scan in the reference frame (higher is better).
 using PoseFitness = std::function<std::uint32_t(const Pose2D&)>;
 
-/// What one alignment maximises: the GA engine is the same whatever scores the poses (GLASM's lookup
-/// tables, PGA's polar pairing), so comparisons at equal evaluations compare the fitness alone.
+/// What one alignment maximises: the GA engine is the same whatever scores the poses (the lookup tables;
+/// the evaluation's PGA, polar pairing), so comparisons at equal evaluations compare the fitness alone.
 struct FitnessStages {
   PoseFitness fine;           ///< scores every pose after the coarse generations, and the guess
   PoseFitness coarse;         ///< the first coarse_generations generations (empty: none)

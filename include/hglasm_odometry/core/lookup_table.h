@@ -14,17 +14,11 @@
 
 namespace hglasm {
 
-enum class TableKind {
-  kGraded,  ///< GLASM-g: 255 * exp(-d^2 / (2 sigma^2)) of the distance d to the nearest reference point
-  kBinary,  ///< GLASM: 1 inside a square of half-side `sigma` around each reference point
-};
-
 struct LookupTableOptions {
-  TableKind kind = TableKind::kGraded;
   /// metres; measured with the success_ratio tool (README): 4 cm cells cost no success against 2 cm and
   /// halve the table build
   double cell_size = 0.04;
-  double sigma = 0.10;   ///< metres: graded spread; half-side of the binary square
+  double sigma = 0.10;   ///< metres: spread of the graded values
   double cutoff = 0.30;  ///< metres: graded cells farther than this from every reference point hold 0
   /// Consecutive reference points of one surface (SurfaceOptions: within segment_max_gap, or the gap a
   /// surface seen at up to segment_max_incidence leaves between beams) are joined: the table then holds
@@ -40,6 +34,18 @@ struct LookupTableOptions {
   SurfaceOptions surface() const { return SurfaceOptions{segment_max_gap, segment_max_incidence}; }
 };
 
+/// The stamp of one reference point: the values of the cells (dx, dy) cells from its cell, |dx|, |dy| <=
+/// radius, row by row. Its largest value is the table's maxCellValue().
+struct TableKernel {
+  int radius = 0;
+  std::vector<std::uint8_t> values;  ///< (2 radius + 1)^2
+};
+/// GLASM-g's stamp, the odometry's: 255 * exp(-d^2 / (2 sigma^2)) of the distance d between the cells'
+/// centres, 0 beyond the cutoff.
+TableKernel gradedKernel(const LookupTableOptions& options);
+/// Makes a table's stamp from its (validated) options.
+using TableKernelFunction = TableKernel (*)(const LookupTableOptions& options);
+
 /// Points prepared for repeated fitness evaluation (single precision, structure of arrays, so the
 /// transform vectorises). Build once per scan with assign().
 struct FitnessPoints {
@@ -53,7 +59,9 @@ struct FitnessPoints {
 /// only tiles of 32 x 32 cells within `cutoff` of a reference point are allocated.
 class LookupTable {
  public:
-  explicit LookupTable(const LookupTableOptions& options = {});
+  /// `kernel`: the stamp (graded; the evaluation library's binary GLASM passes its own). A kernel of the
+  /// wrong size is replaced by the graded one.
+  explicit LookupTable(const LookupTableOptions& options = {}, TableKernelFunction kernel = gradedKernel);
 
   /// Rebuilds the table for new reference points given in beam order (reusing memory). Non-finite points
   /// are ignored.
@@ -87,8 +95,8 @@ class LookupTable {
   std::uint32_t fitness(const std::vector<Eigen::Vector2d>& points, const Pose2D& pose) const;
   std::uint32_t fitness(const FitnessPoints& points, const Pose2D& pose) const;
 
-  /// Value of a cell hit exactly (255 graded, 1 binary): fitness / (maxCellValue * n) is in [0, 1].
-  std::uint32_t maxCellValue() const;
+  /// Value of a cell hit exactly (255 graded): fitness / (maxCellValue * n) is in [0, 1].
+  std::uint32_t maxCellValue() const { return max_cell_value_; }
 
   const LookupTableOptions& options() const { return options_; }
   bool empty() const { return tiles_in_use_ == 0; }
@@ -107,7 +115,8 @@ class LookupTable {
   static bool withinTable(const Eigen::Vector2d& p) {
     return std::abs(p.x()) <= kMaxCoordinate && std::abs(p.y()) <= kMaxCoordinate;  // false for NaN
   }
-  void buildKernel();
+  static LookupTableOptions validated(LookupTableOptions options);
+  void setKernel(const TableKernel& kernel);
   /// Cell value at a point in the table's own frame; 0 outside the table.
   std::uint8_t valueInTable(const Eigen::Vector2d& point) const;
   struct Box {
@@ -206,6 +215,7 @@ class LookupTable {
   std::vector<std::pair<long, long>> kernel_spans_;  // per kernel row: [first, last) non-zero columns
   std::pair<long, long> kernel_rows_;                // [first, last) rows with a non-zero column
   int kernel_radius_ = 0;
+  std::uint32_t max_cell_value_ = 1;
 };
 
 }  // namespace hglasm

@@ -9,29 +9,10 @@
 #include "hglasm_odometry/core/genetic_aligner.h"
 #include "hglasm_odometry/core/lookup_table.h"
 #include "hglasm_odometry/core/mbicp.h"
-#include "hglasm_odometry/core/polar_pairing.h"
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
 
 namespace hglasm {
-
-/// The matcher family of the papers, selectable for comparison.
-enum class Algorithm {
-  kHglasmG,       ///< graded-table GA, then MbICP (the method)
-  kHglasmBinary,  ///< binary-table GA, then MbICP
-  kGlasmG,        ///< graded-table GA alone
-  kGlasmBinary,   ///< binary-table GA alone
-  kMbicp,         ///< MbICP alone from the guess
-  kPga,           ///< PGA (Martinez et al. 2006): the same GA on polar pairing, no lookup table, alone
-  kHpga,          ///< PGA, then MbICP (the hybrid GA-ICP, with this matcher's MbICP)
-};
-const char* toString(Algorithm algorithm);
-/// Parses "hglasm_g", "hglasm_binary", "glasm_g", "glasm_binary", "mbicp", "pga", "hpga". False if unknown.
-bool parseAlgorithm(const std::string& name, Algorithm* algorithm);
-bool usesGeneticStage(Algorithm algorithm);
-bool usesMbicpStage(Algorithm algorithm);
-/// PGA and HPGA: the GA scores poses by polar pairing instead of a lookup table.
-bool usesPolarPairing(Algorithm algorithm);
 
 /// Search-space presets of the papers' Table 1.
 enum class Preset { kSmall, kMedium, kLarge };
@@ -49,9 +30,8 @@ inline LookupTableOptions coarseTableOptions() {
 
 /// The defaults are the medium preset (the default ~preset), as config/presets.yaml documents it.
 struct MatcherOptions {
-  Algorithm algorithm = Algorithm::kHglasmG;
-  LookupTableOptions table;  ///< `kind` is overridden by the algorithm
-  /// Table for the GA's first genetic.coarse_generations generations (same kind as `table`).
+  LookupTableOptions table;
+  /// Table for the GA's first genetic.coarse_generations generations.
   LookupTableOptions coarse_table = coarseTableOptions();
   GeneticOptions genetic;
   /// Measured (README): the information of at most 100 independent points (intel, fr079, aces: with 50 the
@@ -62,7 +42,6 @@ struct MatcherOptions {
     measured.independent_points = 100.0;
     return measured;
   }();
-  PolarPairingOptions pga;  ///< PGA / HPGA only
 };
 
 /// Each preset: the defaults above with the search space of the papers' Table 1 (config/presets.yaml holds
@@ -73,7 +52,7 @@ enum class MatchStatus {
   kOk,
   kNoReference,        ///< match() before setReference(), or an empty reference
   kTooFewPoints,       ///< the new scan has too few valid points
-  kLowFitness,         ///< (pre-alignment alone) nothing in the box fits
+  kLowFitness,         ///< (pre-alignment alone, the evaluation's baselines) nothing in the box fits
   kMbicpFailed,        ///< MbICP: too few associations or degenerate geometry
   kMbicpNotConverged,  ///< MbICP hit its iteration limit (result usable, flagged)
 };
@@ -83,8 +62,8 @@ struct MatchResult {
   Pose2D pose;             ///< new scan in the reference frame (final)
   Pose2D prealigned_pose;  ///< after the GA (the guess when there is no GA stage)
   MatchStatus status = MatchStatus::kNoReference;
-  /// The GA's own fitness of prealigned_pose (its lookup table's cells, or PGA's pairing score; 0 without a
-  /// GA stage). How well the final pose fits is the caller's to judge (OdometryTracker: on the fine table).
+  /// The GA's own fitness of prealigned_pose (its lookup table's cells; 0 without a GA stage). How well the
+  /// final pose fits is the caller's to judge (OdometryTracker: on the fine table).
   std::uint32_t prealigned_fitness = 0;
   double prealigned_fitness_ratio =
       0.0;              ///< prealigned_fitness / its value with every point on the reference
@@ -105,12 +84,22 @@ struct MatchResult {
   bool ok() const { return status == MatchStatus::kOk; }
 };
 
-/// One reference at a time; its lookup table and MbICP structure are built once in setReference().
+/// The stages of a match, for matchers composed of them (ScanMatcher; the evaluation's baselines).
+/// Starts `result` at `guess` (the identity if not finite) with a large covariance; false, with the status
+/// saying why, when there is nothing to match (no reference, fewer than 3 points).
+bool startMatch(bool has_reference, const Scan& scan, const Pose2D& guess, MatchResult* result);
+/// The GA's pose, fitness and evaluations into `result` (its pose too).
+void applyPrealignment(const PreAlignResult& prealigned, MatchResult* result);
+/// MbICP's pose, covariance, information and status into `result` (not its time).
+void applyRefinement(const MbicpResult& refined, MatchResult* result);
+
+/// HGLASM-g, the odometry's matcher: the GA on the graded lookup tables, then MbICP. One reference at a
+/// time; its lookup table and MbICP structure are built once in setReference().
 class ScanMatcher {
  public:
   explicit ScanMatcher(const MatcherOptions& options = {});
 
-  /// Builds the lookup table (if the algorithm has a GA stage) and the MbICP reference.
+  /// Builds the lookup table (unless the caller keeps the tables, useTables) and the MbICP reference.
   void setReference(const Scan& reference);
   /// The same from several scans in one frame (a local map).
   void setReference(const ReferencePoints& reference);
@@ -141,7 +130,7 @@ class ScanMatcher {
   const MatcherOptions& options() const { return options_; }
   const LookupTable& table() const { return fineTable(); }
   /// Lookup tables kept by the caller (a local map's, grown keyframe by keyframe, answering in the frame of
-  /// the reference given to setReference()), which then builds only MbICP's structure (and PGA's). nullptr:
+  /// the reference given to setReference()), which then builds only MbICP's structure. nullptr:
   /// the matcher's own, built by setReference().
   void useTables(const LookupTable* fine, const LookupTable* coarse) {
     external_fine_ = fine;
@@ -161,10 +150,6 @@ class ScanMatcher {
   const LookupTable& coarseTable() const { return external_coarse_ ? *external_coarse_ : coarse_table_; }
   GeneticAligner aligner_;
   Mbicp mbicp_;
-  PolarPairing polar_pairing_;  // PGA's "table": the reference sorted into angular steps
-  FitnessPoints pga_points_;    // scratch: the new scan's points for PGA's fitness
-  /// Fills the defaults of a result (the guess, a large covariance); false if there is nothing to match.
-  bool startResult(const Scan& scan, const Pose2D& guess, MatchResult* result) const;
   void refineInto(const Scan& scan, const PosePrior* prior, MatchResult* result);
 
   bool has_reference_ = false;

@@ -18,6 +18,7 @@
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
 #include "hglasm_odometry/core/scan_matcher.h"
+#include "hglasm_odometry/evaluation/baseline_matcher.h"
 
 namespace hglasm {
 

@@ -66,7 +66,7 @@ bool loadOptions(const ros::NodeHandle& private_nh, LaserOdometryOptions* option
 /// result gives `options` back. For comparing a configuration with the shipped YAML, or printing it.
 XmlRpc::XmlRpcValue toParams(const LaserOdometryOptions& options);
 
-/// One line for the log: preset, algorithm, box, GA size, frames.
+/// One line for the log: preset, box, GA size, frames.
 std::string summarize(const LaserOdometryOptions& options);
 
 }  // namespace hglasm_odometry

@@ -1,6 +1,6 @@
 // PGA (Martinez et al. 2006): polar pairing fitness and the GA on it, on synthetic geometry with exact
 // answers.
-#include "hglasm_odometry/core/polar_pairing.h"
+#include "hglasm_odometry/evaluation/polar_pairing.h"
 
 #include <gtest/gtest.h>
 
@@ -9,9 +9,9 @@
 #include <sstream>
 #include <string>
 
+#include "../core/test_util.h"
 #include "hglasm_odometry/core/genetic_aligner.h"
-#include "hglasm_odometry/core/scan_matcher.h"
-#include "test_util.h"
+#include "hglasm_odometry/evaluation/baseline_matcher.h"
 
 namespace {
 
@@ -134,8 +134,9 @@ TEST_F(PolarRoom, EmptyReferenceScoresNothing) {
 int pgaRecoveries(hglasm::Preset preset, const hglasm_test::LaserSpec& laser, int trials,
                   std::string* misses) {
   const hglasm_test::World world = hglasm_test::room();
-  const hglasm::MatcherOptions matcher = hglasm::presetOptions(preset);
-  PolarPairing pairing(matcher.pga);
+  const hglasm::BaselineOptions baseline = hglasm::baselineOptions(hglasm::Algorithm::kPga, preset);
+  const hglasm::MatcherOptions& matcher = baseline.matcher;
+  PolarPairing pairing(baseline.pga);
   pairing.build(referenceOf(hglasm_test::simulateScan(world, Pose2D(), laser)));
   std::mt19937 rng(99);
   std::uniform_real_distribution<double> unit(-0.9, 0.9);
@@ -180,15 +181,14 @@ TEST(PgaGeneticAligner, LargePresetRecoversDisplacedRoomScansWith360DegreeScans)
 hglasm::MatchResult matchWith(hglasm::Algorithm algorithm, std::uint64_t seed, const Pose2D& truth) {
   const hglasm_test::World world = hglasm_test::room();
   const hglasm_test::LaserSpec laser = hglasm_test::halfCircleLaser();
-  hglasm::MatcherOptions options = hglasm::presetOptions(hglasm::Preset::kMedium);
-  options.algorithm = algorithm;
-  options.genetic.seed = seed;
-  hglasm::ScanMatcher matcher(options);
+  hglasm::BaselineOptions options = hglasm::baselineOptions(algorithm, hglasm::Preset::kMedium);
+  options.matcher.genetic.seed = seed;
+  hglasm::BaselineMatcher matcher(options);
   matcher.setReference(hglasm_test::simulateScan(world, Pose2D(), laser));
   return matcher.match(hglasm_test::simulateScan(world, truth, laser), Pose2D());
 }
 
-TEST(PgaScanMatcher, HybridRefinesToTheTruthAndIsDeterministicPerSeed) {
+TEST(PgaBaselineMatcher, HybridRefinesToTheTruthAndIsDeterministicPerSeed) {
   const Pose2D truth(0.6, -0.4, deg(25.0));
   const hglasm::MatchResult pga = matchWith(hglasm::Algorithm::kPga, 3, truth);
   const hglasm::MatchResult hpga = matchWith(hglasm::Algorithm::kHpga, 3, truth);
@@ -215,7 +215,7 @@ TEST(PgaScanMatcher, HybridRefinesToTheTruthAndIsDeterministicPerSeed) {
                other.prealigned_fitness == pga.prealigned_fitness && other.evaluations == pga.evaluations);
 }
 
-TEST(PgaScanMatcher, AlgorithmNamesParse) {
+TEST(PgaBaselineMatcher, AlgorithmNamesParse) {
   hglasm::Algorithm algorithm = hglasm::Algorithm::kMbicp;
   ASSERT_TRUE(hglasm::parseAlgorithm("pga", &algorithm));
   EXPECT_EQ(algorithm, hglasm::Algorithm::kPga);

@@ -1,4 +1,4 @@
-#include "hglasm_odometry/core/polar_pairing.h"
+#include "hglasm_odometry/evaluation/polar_pairing.h"
 
 #include "hglasm_odometry/core/fast_math.h"
 
