@@ -1,27 +1,12 @@
 #include "hglasm_odometry/core/odometry_pipeline.h"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 #include <sstream>
 
+#include "hglasm_odometry/core/cpu_time.h"
+
 namespace hglasm {
-namespace {
-
-/// CPU time of the calling thread (process CPU where POSIX thread clocks are missing), milliseconds.
-double threadCpuMs() {
-#if defined(CLOCK_THREAD_CPUTIME_ID)
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return now.tv_sec * 1e3 + now.tv_nsec * 1e-6;
-#else
-  return 1e3 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
-#endif
-}
-
-}  // namespace
 
 ScanConversionOptions conversionForMount(ScanConversionOptions conversion, bool upside_down) {
   conversion.mirror = upside_down;

@@ -1,7 +1,5 @@
 #include "hglasm_odometry/ros/laser_odometry.h"
 
-#include <time.h>
-
 #include <algorithm>
 #include <chrono>
 #include <sstream>
@@ -9,15 +7,10 @@
 
 #include <geometry_msgs/TransformStamped.h>
 
+#include "hglasm_odometry/core/cpu_time.h"
+
 namespace hglasm_odometry {
 namespace {
-
-/// CPU time of the calling thread, milliseconds.
-double threadCpuMs() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return now.tv_sec * 1e3 + now.tv_nsec * 1e-6;
-}
 
 /// Seconds on the clock of the throttling, the mounts' retries and the diagnostics (monotonic).
 double steadySeconds() {
@@ -376,14 +369,14 @@ void LaserOdometry::useLaserMount(std::string_view frame, const LaserMount& moun
 
 void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
   const auto start = std::chrono::steady_clock::now();
-  const double cpu_start = threadCpuMs();
+  const double cpu_start = hglasm::threadCpuMs();
   const bool with_population = output_.populationWanted();
   rangeScanFromMsg(msg, &ranges_);
   const hglasm::PipelineUpdate result =
       pipeline_.processScan(msg.header.stamp.toSec(), ranges_, with_population ? &population_ : nullptr);
   reportScan(result);
   publish(msg.header, result, with_population, msSince(start));
-  recordScan(result.tracker, threadCpuMs() - cpu_start);
+  recordScan(result.tracker, hglasm::threadCpuMs() - cpu_start);
 }
 
 void LaserOdometry::publish(const std_msgs::Header& scan, const hglasm::PipelineUpdate& result,

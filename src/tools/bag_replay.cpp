@@ -4,7 +4,7 @@
 #include <deque>
 #include <limits>
 
-#include "hglasm_odometry/tools/cpu_time.h"
+#include "hglasm_odometry/core/cpu_time.h"
 
 namespace hglasm_odometry {
 namespace {
@@ -81,9 +81,9 @@ class Replay {
     ReplayedScan replayed;
     replayed.scan = waiting_.front();
     waiting_.pop_front();
-    const double start = threadCpuMs();
+    const double start = hglasm::threadCpuMs();
     replayed.update = pipeline_->processScan(replayed.scan->stamp, replayed.scan->ranges);
-    replayed.cpu_ms = threadCpuMs() - start;
+    replayed.cpu_ms = hglasm::threadCpuMs() - start;
     ++counts_.processed;
     wait_start_ = now;  // the worker turns to the next scan
     on_scan_(replayed);

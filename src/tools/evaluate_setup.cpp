@@ -7,7 +7,7 @@
 #include <ros/package.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
-#include "hglasm_odometry/tools/cpu_time.h"
+#include "hglasm_odometry/core/cpu_time.h"
 #include "hglasm_odometry/tools/yaml_parameters.h"
 
 namespace hglasm_odometry {
@@ -139,12 +139,12 @@ bool readEvaluateInputs(const EvaluateArguments& args, const std::string& base_f
   read_options.odom_topic = args.odom_topic;
   read_options.max_scans = args.max_scans;
   read_options.base_frame = base_frame;
-  const double read_start = processCpuMs();
+  const double read_start = hglasm::processCpuMs();
   BagData& data = inputs->data;
   if (!readBag(args.bag, read_options, &data, error)) return false;
   if (!args.relations.empty() && !hglasm::readRelations(args.relations, &inputs->relations, error))
     return false;
-  inputs->read_cpu_seconds = (processCpuMs() - read_start) * 1e-3;
+  inputs->read_cpu_seconds = (hglasm::processCpuMs() - read_start) * 1e-3;
   inputs->mount_source = data.has_laser_mount ? "from tf" : "not found, identity";
   if (args.override_mount) {
     data.has_laser_mount = true;
