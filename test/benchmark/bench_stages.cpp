@@ -7,10 +7,12 @@
 // (`points`, `tiles`, `success`: the share of matches within 0.10 m / 0.01 rad of the truth, `matched`: the
 // share of the sequence's scans the tracker matched; MbICP's mean `iterations` too, since a cheaper
 // association that costs iterations is no gain). Sequence benchmarks time one pass over the block per
-// iteration (a fresh map or pipeline, made with the timer paused) and report CPU time `per_scan` /
-// `per_keyframe`.
+// iteration (a fresh map or pipeline, made with the timer paused) and count its scans or keyframes as
+// items: CPU time per scan or keyframe = 1 / items_per_second. Only what Google Benchmark 1.5.0 (Ubuntu
+// 20.04) has: no Counter::kInvert, no benchmark::Shutdown().
 #include <benchmark/benchmark.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <optional>
 #include <random>
@@ -86,12 +88,6 @@ bool success(const Pose2D& estimate, const Pose2D& truth) {
          hglasm_test::rotationError(estimate, truth) < 0.01;
 }
 
-/// CPU seconds per item of an iteration (sequence benchmarks: per scan, per keyframe).
-benchmark::Counter perItem(double items) {
-  return benchmark::Counter(items,
-                            benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
-}
-
 // ------------------------------------------------------------------------------------------ the stages
 
 /// RangeScan -> Scan: range limits, invalid beams dropped, beam angles (the default conversion).
@@ -156,7 +152,7 @@ void benchmarkKeyframes(benchmark::State& state, const Fixture& fixture, double 
     benchmark::DoNotOptimize(matcher.hasReference());
     reference_points = map->reference().size();
   }
-  state.counters["per_keyframe"] = perItem(static_cast<double>(scans.size()));
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(scans.size()));  // keyframes
   state.counters["points"] = static_cast<double>(reference_points);
 }
 
@@ -218,7 +214,7 @@ void benchmarkPipeline(benchmark::State& state, const Fixture& fixture) {
       updates += update.tracker.matched ? 1 : 0;
     }
   }
-  state.counters["per_scan"] = perItem(static_cast<double>(fixture.consecutive.size()));
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(fixture.consecutive.size()));
   state.counters["matched"] = updates ? static_cast<double>(matched) / updates : 0.0;
 }
 
@@ -285,6 +281,5 @@ int main(int argc, char** argv) {
   for (const Fixture& fixture : fixtures) registerSingleScanStages(fixture);
   for (const Fixture& fixture : fixtures) registerSequenceStages(fixture);
   benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
   return 0;
 }
