@@ -177,7 +177,6 @@ int main(int argc, char** argv) {
     })->Unit(benchmark::kMillisecond);
   }
 
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
+  benchmark::RunSpecifiedBenchmarks();  // no Shutdown(): Noetic's Google Benchmark 1.5.0 lacks it
   return 0;
 }
