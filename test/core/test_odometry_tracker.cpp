@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
-#include <random>
 #include <utility>
 
+#include "simulated_robot.h"
 #include "test_expect.h"
 #include "test_util.h"
 
@@ -22,8 +22,8 @@ using hglasm::PredictionSource;
 using hglasm::TrackerOptions;
 using hglasm::TrackerUpdate;
 
-using Path = std::function<Pose2D(double)>;
 using hglasm_test::kPi;
+using hglasm_test::Path;
 
 /// Clockwise circle of radius 1.5 m through the origin at 0.5 m/s, starting at the identity pose; it stays
 /// clear of the room's boxes and walls.
@@ -53,85 +53,59 @@ void expectSane(const TrackerUpdate& update) {
   EXPECT_TRUE(update.diagnostics.match.covariance.allFinite());
 }
 
-/// Drives a simulated robot along `path` and feeds the tracker its scans (and optionally wheel odometry).
-class SimulatedRobot {
+/// The simulated robot (simulated_robot.h) feeding an OdometryTracker: its wheel and gyro samples up to
+/// each scan, then the scan.
+class Robot {
  public:
-  SimulatedRobot(const TrackerOptions& options, Path path)
-      : tracker_(options),
-        path_(path),
-        world_(hglasm_test::room()),
-        laser_(hglasm_test::halfCircleLaser()),
-        wheels_(std::move(path)) {}
+  Robot(const TrackerOptions& options, Path path) : tracker_(options), sim_(std::move(path)) {
+    sim_.setMount(Pose2D());  // these scans always went through the mount, the identity included
+  }
 
   void setMount(const Pose2D& mount) {
-    mount_ = mount;
+    sim_.setMount(mount);
     tracker_.setLaserMount(mount);
   }
 
   /// Wheel odometry with a scale error and a heading drift (integrated from the true motion), that counts
   /// `turn_scale` of every turn (a skid-steer robot's wheels slip as it turns).
   void enableOdometry(double scale_error, double drift_per_metre, double turn_scale = 1.0) {
-    odometry_ = true;
-    wheels_.setErrors(scale_error, drift_per_metre, turn_scale);
+    sim_.enableWheels();
+    sim_.wheels().setErrors(scale_error, drift_per_metre, turn_scale);
   }
 
   /// A gyro at 200 Hz: the true yaw rate plus a constant `bias` (rad/s) and white noise of
   /// `noise_density` (rad/s per sqrt(Hz)), from a seeded generator.
   void enableGyro(double bias, double noise_density, unsigned seed) {
-    gyro_ = true;
-    gyro_bias_ = bias;
-    gyro_sigma_ = noise_density * std::sqrt(1.0 / kGyroPeriod);
-    gyro_random_.seed(seed);
+    hglasm_test::GyroSpec gyro;
+    gyro.bias = bias;
+    gyro.noise_density = noise_density;
+    gyro.seed = seed;
+    sim_.enableGyro(gyro);
   }
-  void disableGyro() { gyro_ = false; }
+  void disableGyro() { sim_.disableGyro(); }
 
-  Pose2D truth(double t) const { return path_(t); }
-  Pose2D odometryPose() const { return wheels_.pose(); }
+  Pose2D truth(double t) const { return sim_.truth(t); }
+  Pose2D odometryPose() const { return sim_.wheels().pose(); }
 
   /// A laser whose sweep lasts `seconds` from the first beam to the last (0: all beams at once).
-  void setSweepTime(double seconds) { sweep_time_ = seconds; }
+  void setSweepTime(double seconds) { sim_.setSweepTime(seconds); }
+  hglasm::Scan scanAt(double t) const { return sim_.scanAt(t); }
 
-  /// Scan of the laser on the robot at time t: each beam leaves from where the robot is when it is measured.
-  hglasm::Scan scanAt(double t) const {
-    const double time_increment = sweep_time_ > 0.0 ? sweep_time_ / (laser_.beams - 1) : 0.0;
-    hglasm::Scan scan = hglasm_test::simulateSweep(
-        world_,
-        [&](int beam) { return hglasm_test::composeByHand(path_(t + beam * time_increment), mount_); },
-        laser_);
-    scan.time_increment = time_increment;
-    return scan;
-  }
-
-  /// Advances to time t: wheel odometry at 50 Hz up to t, then one scan at t (or `scan` if given).
+  /// Advances to time t: the wheels up to t and the gyro to the end of the sweep, then one scan at t (or
+  /// `scan` if given).
   TrackerUpdate step(double t, const hglasm::Scan* scan = nullptr) {
-    if (odometry_)
-      wheels_.advance(t, [this](double time, const Pose2D& pose) { tracker_.addOdometry(time, pose); });
-    // As live, the scan is processed once its sweep is over: the IMU's samples of the sweep are there.
-    while (gyro_ && gyro_time_ + kGyroPeriod <= t + sweep_time_ + 1e-9) {
-      gyro_time_ += kGyroPeriod;
-      std::normal_distribution<double> noise(0.0, gyro_sigma_);
-      tracker_.addImu(gyro_time_, hglasm_test::yawRate(path_, gyro_time_) + gyro_bias_ + noise(gyro_random_));
-    }
-    return scan ? tracker_.processScan(t, *scan) : tracker_.processScan(t, scanAt(t));
+    hglasm_test::RobotSink sink;
+    sink.wheels = [this](double stamp, const Pose2D& pose) { tracker_.addOdometry(stamp, pose); };
+    sink.gyro = [this](double stamp, double yaw_rate) { tracker_.addImu(stamp, yaw_rate); };
+    sim_.advanceTo(t, sink);
+    return tracker_.processScan(t, scan ? *scan : sim_.scanAt(t));
   }
 
   OdometryTracker& tracker() { return tracker_; }
 
  private:
   OdometryTracker tracker_;
-  Path path_;
-  hglasm_test::World world_;
-  hglasm_test::LaserSpec laser_;
-  Pose2D mount_;
-  double sweep_time_ = 0.0;
-  hglasm_test::SimulatedWheels wheels_;  // integrated from the identity at t = 0
-  bool odometry_ = false;
-  static constexpr double kGyroPeriod = 0.005;  // s
-  bool gyro_ = false;
-  double gyro_bias_ = 0.0;
-  double gyro_sigma_ = 0.0;
-  double gyro_time_ = -kGyroPeriod;
-  std::mt19937 gyro_random_;
+  hglasm_test::SimulatedRobot sim_;
 };
 
 TrackerOptions withoutOdometry() {
@@ -141,7 +115,7 @@ TrackerOptions withoutOdometry() {
 }
 
 TEST(OdometryTracker, FirstScanIsPublishedAtTheOrigin) {
-  SimulatedRobot robot(TrackerOptions(), circlePath);
+  Robot robot(TrackerOptions(), circlePath);
   const TrackerUpdate first = robot.step(0.0);
   expectSane(first);
   EXPECT_TRUE(first.published);
@@ -155,7 +129,7 @@ TEST(OdometryTracker, FirstScanIsPublishedAtTheOrigin) {
 }
 
 TEST(OdometryTracker, AfterAResetTheVelocityIsUnknownAgain) {
-  SimulatedRobot robot(TrackerOptions(), circlePath);
+  Robot robot(TrackerOptions(), circlePath);
   TrackerUpdate update;
   for (int i = 0; i <= 10; ++i) update = robot.step(0.1 * i);
   EXPECT_LT(update.velocity_covariance(0, 0), 1.0) << "a second of motion: the velocity is known";
@@ -166,7 +140,7 @@ TEST(OdometryTracker, AfterAResetTheVelocityIsUnknownAgain) {
 }
 
 /// Drives `seconds` at 10 Hz; returns the final update. Every update must be sane and matched.
-TrackerUpdate drive(SimulatedRobot* robot, double seconds, int* fallbacks, int* keyframes) {
+TrackerUpdate drive(Robot* robot, double seconds, int* fallbacks, int* keyframes) {
   TrackerUpdate update;
   *fallbacks = 0;
   *keyframes = 0;
@@ -184,7 +158,7 @@ TrackerUpdate drive(SimulatedRobot* robot, double seconds, int* fallbacks, int* 
 }
 
 TEST(OdometryTracker, FollowsACircleWithoutWheelOdometry) {
-  SimulatedRobot robot(withoutOdometry(), circlePath);
+  Robot robot(withoutOdometry(), circlePath);
   int fallbacks = 0, keyframes = 0;
   const TrackerUpdate last = drive(&robot, 25.0, &fallbacks, &keyframes);  // 12.5 m, 5/6 of a turn
   const Pose2D truth = robot.truth(25.0);
@@ -199,7 +173,7 @@ TEST(OdometryTracker, FollowsACircleWithoutWheelOdometry) {
 }
 
 TEST(OdometryTracker, FollowsACircleWithDriftingWheelOdometry) {
-  SimulatedRobot robot(TrackerOptions(), circlePath);
+  Robot robot(TrackerOptions(), circlePath);
   robot.enableOdometry(0.05, 0.03);  // 5 % scale error, 0.03 rad of heading drift per metre
   int fallbacks = 0, keyframes = 0;
   const TrackerUpdate last = drive(&robot, 25.0, &fallbacks, &keyframes);
@@ -214,7 +188,7 @@ TEST(OdometryTracker, FollowsACircleWithDriftingWheelOdometry) {
 TEST(OdometryTracker, ThePublishedFitnessIsTheGradedTablesAtThePublishedPose) {
   // The published fitness (and min_fitness) is the fine graded table's at the published pose.
   TrackerOptions options;
-  SimulatedRobot robot(options, circlePath);
+  Robot robot(options, circlePath);
   robot.enableOdometry(0.02, 0.01);
   int fallbacks = 0, keyframes = 0;
   const TrackerUpdate last = drive(&robot, 3.0, &fallbacks, &keyframes);
@@ -228,7 +202,7 @@ TEST(OdometryTracker, ThePublishedFitnessIsTheGradedTablesAtThePublishedPose) {
 TEST(OdometryTracker, AFailedMatchPublishesTheFitnessAtThePredictedPose) {
   TrackerOptions options;
   options.min_fitness = 1.0;  // no match is good enough: every scan integrates the wheels
-  SimulatedRobot robot(options, circlePath);
+  Robot robot(options, circlePath);
   robot.enableOdometry(0.0, 0.0);  // exact wheels: the predicted pose is the true one
   robot.step(0.0);
   const TrackerUpdate update = robot.step(0.1);
@@ -239,7 +213,7 @@ TEST(OdometryTracker, AFailedMatchPublishesTheFitnessAtThePredictedPose) {
 }
 
 TEST(OdometryTracker, LaserMountIsAccountedFor) {
-  SimulatedRobot robot(withoutOdometry(), circlePath);
+  Robot robot(withoutOdometry(), circlePath);
   robot.setMount(Pose2D(0.3, 0.1, 0.2));
   int fallbacks = 0, keyframes = 0;
   const TrackerUpdate last = drive(&robot, 10.0, &fallbacks, &keyframes);
@@ -257,7 +231,7 @@ TEST(OdometryTracker, DeskewUndoesTheShearOfASweepTakenWhileMoving) {
     TrackerOptions options = withoutOdometry();
     options.deskew = deskew;
     options.local_map.keyframes = 4;  // the un-de-skewed first keyframes leave the map within 5 s
-    SimulatedRobot robot(options, circlePath);
+    Robot robot(options, circlePath);
     robot.setMount(Pose2D(0.3, 0.1, 0.2));
     robot.setSweepTime(0.1);
     int fallbacks = 0;
@@ -291,7 +265,7 @@ TEST(OdometryTracker, KeyframesFollowKeyframeDistance) {
   TrackerOptions options = withoutOdometry();
   options.keyframe.distance = 0.30;
   options.keyframe.angle = 10.0;
-  SimulatedRobot robot(options, straightPath(0.4));  // 0.04 m per scan
+  Robot robot(options, straightPath(0.4));  // 0.04 m per scan
   int keyframes = 0;
   for (int i = 1; i <= 40; ++i) {  // 1.6 m: a new keyframe past every 0.30 m, i.e. every 8 scans
     const TrackerUpdate update = robot.step(0.1 * i);
@@ -310,7 +284,7 @@ TEST(OdometryTracker, KeyframesFollowKeyframeAngle) {
   TrackerOptions options = withoutOdometry();
   options.keyframe.distance = 100.0;
   options.keyframe.angle = 0.20;
-  SimulatedRobot robot(options, spinPath(0.3));  // 0.03 rad per scan
+  Robot robot(options, spinPath(0.3));  // 0.03 rad per scan
   int keyframes = 0;
   const int first_keyframe = robot.step(0.0).keyframe_id;
   for (int i = 1; i <= 42; ++i) {  // a new keyframe past every 0.2 rad, i.e. every 7 scans
@@ -330,7 +304,7 @@ TEST(OdometryTracker, KeyframesFollowKeyframeAngle) {
 TEST(OdometryTracker, AScanStampedBeforeTheLastOneIsNotProcessed) {
   // The tracker processes scans in stamp order (OdometryPipeline drops older ones, or restarts on a clock
   // that jumped back): one handed to it out of order changes nothing.
-  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  Robot robot(withoutOdometry(), straightPath(0.4));
   for (int i = 0; i <= 10; ++i) robot.step(0.1 * i);
   const Pose2D before = robot.tracker().pose();
   const TrackerUpdate back = robot.step(0.5);
@@ -355,7 +329,7 @@ TEST(OdometryTracker, AForwardGapContinuesFromThePose) {
   const Path stop_and_go = [](double t) {
     return hglasm_test::rawPose(0.4 * std::min(t, 0.5) + 0.4 * std::max(0.0, t - 600.5), 0.0, 0.0);
   };
-  SimulatedRobot robot(TrackerOptions(), stop_and_go);
+  Robot robot(TrackerOptions(), stop_and_go);
   robot.enableOdometry(0.0, 0.0);
   for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
   const TrackerUpdate gap = robot.step(0.6 + 600.0);
@@ -372,7 +346,7 @@ TEST(OdometryTracker, AForwardGapContinuesFromThePose) {
 TEST(OdometryTracker, DuplicateStampsNeverGiveNaN) {
   for (bool with_odometry : {false, true}) {
     SCOPED_TRACE(with_odometry ? "with odometry" : "without odometry");
-    SimulatedRobot robot(with_odometry ? TrackerOptions() : withoutOdometry(), straightPath(0.4));
+    Robot robot(with_odometry ? TrackerOptions() : withoutOdometry(), straightPath(0.4));
     if (with_odometry) robot.enableOdometry(0.0, 0.0);
     for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
     const hglasm::Scan same = robot.scanAt(0.5);
@@ -396,7 +370,7 @@ TEST(OdometryTracker, DuplicateStampsNeverGiveNaN) {
 }
 
 TEST(OdometryTracker, EmptyScansFallBackToTheOdometryGuess) {
-  SimulatedRobot robot(TrackerOptions(), circlePath);
+  Robot robot(TrackerOptions(), circlePath);
   robot.enableOdometry(0.0, 0.0);  // exact wheel odometry: the fallback must follow it
   for (int i = 0; i <= 20; ++i) robot.step(0.1 * i);
   const hglasm::Scan empty;
@@ -421,7 +395,7 @@ TEST(OdometryTracker, EmptyScansFallBackToTheOdometryGuess) {
 }
 
 TEST(OdometryTracker, EmptyScansWithoutOdometryKeepTheConstantVelocity) {
-  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  Robot robot(withoutOdometry(), straightPath(0.4));
   for (int i = 0; i <= 10; ++i) robot.step(0.1 * i);
   const TrackerUpdate before = robot.step(1.1);
   const hglasm::Scan empty;
@@ -438,7 +412,7 @@ TEST(OdometryTracker, EmptyScansWithoutOdometryKeepTheConstantVelocity) {
 }
 
 TEST(OdometryTracker, TooFewPointsAndNonFiniteScansAreFallbacks) {
-  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  Robot robot(withoutOdometry(), straightPath(0.4));
   for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
   hglasm::Scan few = robot.scanAt(0.6);
   few.points.resize(5);
@@ -459,7 +433,7 @@ TEST(OdometryTracker, TooFewPointsAndNonFiniteScansAreFallbacks) {
 }
 
 TEST(OdometryTracker, ExplicitResetRestartsAtTheOrigin) {
-  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  Robot robot(withoutOdometry(), straightPath(0.4));
   for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
   robot.tracker().reset();
   const TrackerUpdate update = robot.step(0.6);
@@ -477,7 +451,7 @@ Eigen::Matrix3d someCovariance() {
 }
 
 TEST(OdometryTracker, SetPoseContinuesFromTheGivenPoseWithTheWheelMotionSince) {
-  SimulatedRobot robot(TrackerOptions(), straightPath(0.4));
+  Robot robot(TrackerOptions(), straightPath(0.4));
   robot.enableOdometry(0.0, 0.0);
   for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
   const Pose2D set(2.0, -1.0, 0.5);
@@ -504,7 +478,7 @@ TEST(OdometryTracker, SetPoseContinuesFromTheGivenPoseWithTheWheelMotionSince) {
 }
 
 TEST(OdometryTracker, SetPoseAtTheScanStampKeepsTheGivenCovariance) {
-  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  Robot robot(withoutOdometry(), straightPath(0.4));
   for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
   const Pose2D set(-3.0, 4.0, -2.0);
   ASSERT_TRUE(robot.tracker().setPose(0.6, set, someCovariance()));
@@ -519,7 +493,7 @@ TEST(OdometryTracker, SetPoseAtTheScanStampKeepsTheGivenCovariance) {
 }
 
 TEST(OdometryTracker, ResetAndSetPoseInterleavedTheLastOneWins) {
-  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  Robot robot(withoutOdometry(), straightPath(0.4));
   for (int i = 0; i <= 3; ++i) robot.step(0.1 * i);
   const Pose2D set(1.0, 2.0, 0.3);
   ASSERT_TRUE(robot.tracker().setPose(0.3, set, someCovariance()));
@@ -548,7 +522,7 @@ TEST(OdometryTracker, ResetAndSetPoseInterleavedTheLastOneWins) {
 }
 
 TEST(OdometryTracker, SetPoseRejectsInvalidInputAndChangesNothing) {
-  SimulatedRobot robot(withoutOdometry(), straightPath(0.4));
+  Robot robot(withoutOdometry(), straightPath(0.4));
   for (int i = 0; i <= 5; ++i) robot.step(0.1 * i);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
@@ -600,7 +574,7 @@ FastTurnRun runFastTurns(bool use_imu, double turn_rate, double scan_rate, doubl
   options.prediction.use_imu = use_imu;
   options.prediction.imu = gyro;
   const Path path = hglasm_test::squareWithSpins(turn_rate);
-  SimulatedRobot robot(options, path);
+  Robot robot(options, path);
   robot.enableOdometry(0.0, 0.0, turn_scale);
   robot.setSweepTime(sweep_fraction / scan_rate);
   if (use_imu) robot.enableGyro(bias, noise_density, 7);
@@ -731,7 +705,7 @@ TEST(OdometryTracker, WithASweepingLaserTheGyroDeskewsTheSpins) {
 TEST(OdometryTracker, WhenTheGyroStopsTheWheelsPredictTheRotation) {
   TrackerOptions options;
   options.prediction.use_imu = true;
-  SimulatedRobot robot(options, circlePath);
+  Robot robot(options, circlePath);
   robot.enableOdometry(0.0, 0.0);
   robot.enableGyro(kGyroBias, kGyroNoiseDensity, 3);
   TrackerUpdate update;

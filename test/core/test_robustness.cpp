@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "simulated_robot.h"
 #include "test_expect.h"
 #include "test_util.h"
 
@@ -34,7 +35,7 @@ using hglasm::TrackerUpdate;
 using hglasm_test::deg;
 using hglasm_test::expectPoseNear;
 using hglasm_test::LaserSpec;
-using Path = std::function<Pose2D(double)>;
+using hglasm_test::Path;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -77,40 +78,35 @@ void expectSane(const TrackerUpdate& u) {
   EXPECT_TRUE(u.diagnostics.match.covariance.allFinite()) << describe(u);
 }
 
-/// A simulated robot whose scans and wheel odometry (optional, 50 Hz, can be delayed or corrupted) go
-/// through the pipeline the nodelet runs.
+/// The simulated robot (simulated_robot.h) feeding the pipeline the nodelet runs: its wheel odometry
+/// (optional, 50 Hz from t = 0, can be delayed or corrupted) up to each scan, then the scan.
 class Robot {
  public:
   Robot(const TrackerOptions& options, Path path, LaserSpec laser = hglasm_test::halfCircleLaser(),
         hglasm_test::World world = hglasm_test::room())
-      : pipeline_(options),
-        path_(path),
-        wheels_(std::move(path), -0.02),
-        world_(std::move(world)),
-        laser_(laser) {}
+      : pipeline_(options), sim_(std::move(path), std::move(world), laser, -0.02) {}
 
-  void setLaser(const LaserSpec& laser) { laser_ = laser; }
+  void setLaser(const LaserSpec& laser) { sim_.setLaser(laser); }
   /// Exact wheel odometry (the truth), optionally with a permanent offset added from `jump_time` on.
   void enableOdometry(double jump_time = std::numeric_limits<double>::infinity(),
                       const Pose2D& jump = Pose2D()) {
-    odometry_ = true;
-    jump_time_ = jump_time;
-    jump_ = jump;
+    sim_.enableWheels();
+    sim_.setWheelJump(jump_time, jump);
   }
   /// The wheels report this path instead of the true one (their own errors).
-  void setOdometryPath(Path path) { wheels_.setPath(std::move(path)); }
+  void setOdometryPath(Path path) { sim_.wheels().setPath(std::move(path)); }
   /// Odometry samples are handed to the tracker only `delay` seconds after their stamp.
-  void setOdometryDelay(double delay) { odometry_delay_ = delay; }
+  void setOdometryDelay(double delay) { sim_.setWheelDelay(delay); }
 
-  Pose2D truth(double t) const { return path_(t); }
-  RangeScan rangesAt(double t) const { return hglasm_test::simulateRanges(world_, path_(t), laser_); }
+  Pose2D truth(double t) const { return sim_.truth(t); }
+  RangeScan rangesAt(double t) const { return sim_.rangesAt(t); }
 
   /// The clock of the scans and the odometry is ahead of the simulated time by `offset` from now on.
-  void setStampOffset(double offset) { stamp_offset_ = offset; }
+  void setStampOffset(double offset) { sim_.setStampOffset(offset); }
 
   /// Feeds the odometry available at wall time t (stamps <= t - delay), then the scan taken at t.
   TrackerUpdate step(double t, const RangeScan* ranges = nullptr) {
-    return stepAt(t, t + stamp_offset_, ranges);
+    return stepAt(t, sim_.stampOf(t), ranges);
   }
 
   /// The next scan's time, 0.1 s after the last one's.
@@ -119,12 +115,11 @@ class Robot {
   /// As step(), but the scan carries `stamp` (time faults) while the world is seen at `t`.
   TrackerUpdate stepAt(double t, double stamp, const RangeScan* ranges = nullptr) {
     last_time_ = t;
-    if (odometry_) {
-      wheels_.advance(t - odometry_delay_, [this](double time, const Pose2D& pose) {
-        pipeline_.addOdometry(time + stamp_offset_,
-                              time >= jump_time_ ? hglasm_test::composeByHand(jump_, pose) : pose);
-      });
-    }
+    hglasm_test::RobotSink sink;
+    sink.wheels = [this](double wheel_stamp, const Pose2D& pose) {
+      pipeline_.addOdometry(wheel_stamp, pose);
+    };
+    sim_.advanceTo(t, sink);
     const RangeScan scan = ranges ? *ranges : rangesAt(t);
     const hglasm::PipelineUpdate result = pipeline_.processScan(stamp, scan);
     last_error_ = result.scan_error;
@@ -139,16 +134,8 @@ class Robot {
 
  private:
   OdometryPipeline pipeline_;
-  Path path_;
-  hglasm_test::SimulatedWheels wheels_;  // exact: the truth or setOdometryPath's; the first sample at t = 0
-  hglasm_test::World world_;
-  LaserSpec laser_;
-  bool odometry_ = false;
-  double odometry_delay_ = 0.0;
-  double stamp_offset_ = 0.0;
+  hglasm_test::SimulatedRobot sim_;
   double last_time_ = 0.0;
-  double jump_time_ = std::numeric_limits<double>::infinity();
-  Pose2D jump_;
   std::vector<std::string> warnings_;
   hglasm::ScanError last_error_ = hglasm::ScanError::kNone;
 };

@@ -11,7 +11,6 @@
 
 #include <Eigen/Geometry>
 #include <memory>
-#include <random>
 
 #include <sensor_msgs/Imu.h>
 
@@ -48,48 +47,54 @@ geometry_msgs::Quaternion toMsg(const Eigen::Quaterniond& q) {
   return msg;
 }
 
-/// An IMU on the simulated robot: its angular velocity (the base's yaw rate seen in the IMU's frame, plus
-/// bias and seeded white noise) and its orientation (the base's yaw composed with the mount) at 200 Hz.
-class SimulatedImu {
+/// The IMU of the simulated robot, published: the gyro's yaw rate (simulated_robot.h: bias, seeded noise)
+/// seen in the IMU's frame, and the orientation (the base's yaw composed with the mount).
+class ImuPublisher {
  public:
-  SimulatedImu(ros::NodeHandle& nh, const std::string& topic, std::string frame, Path path)
-      : pub_(nh.advertise<sensor_msgs::Imu>(topic, 2000)), frame_(std::move(frame)), path_(std::move(path)) {}
+  ImuPublisher(ros::NodeHandle& nh, const std::string& topic, std::string frame,
+               hglasm_test::SimulatedRobot& sim)
+      : pub_(nh.advertise<sensor_msgs::Imu>(topic, 2000)), frame_(std::move(frame)), sim_(sim) {
+    hglasm_test::GyroSpec gyro;
+    gyro.period = kImuPeriod;
+    gyro.bias = kImuBias;
+    gyro.noise_density = kImuNoiseDensity;
+    gyro.seed = 11;
+    gyro.pairs_within_call = true;
+    sim_.enableGyro(gyro);
+  }
 
   bool connected() const { return pub_.getNumSubscribers() > 0; }
 
   /// Samples up to simulated time t; with `silent`, none are sent (the IMU stalled) but time goes on.
   void publishUntil(double t, bool silent = false) {
-    std::normal_distribution<double> noise(0.0, kImuNoiseDensity / std::sqrt(kImuPeriod));
-    for (; t_ + kImuPeriod <= t + 1e-9;) {
-      t_ += kImuPeriod;
-      const double yaw_rate = hglasm_test::yawRate(path_, t_) + kImuBias;
-      const double sample_noise = noise(random_);
-      if (silent) continue;
-      const Eigen::Quaterniond base(Eigen::AngleAxisd(path_(t_).theta, Eigen::Vector3d::UnitZ()));
-      const Eigen::Vector3d rate = imuMount().inverse() * Eigen::Vector3d(0.0, 0.0, yaw_rate + sample_noise);
-      sensor_msgs::Imu msg;
-      msg.header.stamp = ros::Time(kStampOrigin + t_);
-      msg.header.frame_id = frame_;
-      msg.angular_velocity.x = rate.x();
-      msg.angular_velocity.y = rate.y();
-      msg.angular_velocity.z = rate.z();
-      msg.orientation = toMsg(base * imuMount());
-      msg.orientation_covariance[0] = msg.angular_velocity_covariance[0] = 1e-4;
-      pub_.publish(msg);
-    }
+    hglasm_test::RobotSink sink;
+    if (!silent) sink.gyro = [this](double time, double yaw_rate) { publish(time, yaw_rate); };
+    sim_.advanceGyro(t, sink);
   }
 
  private:
+  void publish(double time, double yaw_rate) {
+    const Eigen::Quaterniond base(Eigen::AngleAxisd(sim_.truth(time).theta, Eigen::Vector3d::UnitZ()));
+    const Eigen::Vector3d rate = imuMount().inverse() * Eigen::Vector3d(0.0, 0.0, yaw_rate);
+    sensor_msgs::Imu msg;
+    msg.header.stamp = ros::Time(kStampOrigin + time);
+    msg.header.frame_id = frame_;
+    msg.angular_velocity.x = rate.x();
+    msg.angular_velocity.y = rate.y();
+    msg.angular_velocity.z = rate.z();
+    msg.orientation = toMsg(base * imuMount());
+    msg.orientation_covariance[0] = msg.angular_velocity_covariance[0] = 1e-4;
+    pub_.publish(msg);
+  }
+
   ros::Publisher pub_;
   std::string frame_;
-  Path path_;
-  double t_ = -kImuPeriod;
-  std::mt19937 random_{11};
+  hglasm_test::SimulatedRobot& sim_;
 };
 
 struct Instance {
   std::unique_ptr<Robot> robot;
-  std::unique_ptr<SimulatedImu> imu;                     // null for the wheels-only instance
+  std::unique_ptr<ImuPublisher> imu;                     // null for the wheels-only instance
   double worst_translation = 0.0, worst_rotation = 0.0;  // of every pose since the start
   int rotations_from_imu = 0, leaps = 0, resets = 0;
   double imu_bias = 0.0;  // as the last ~match published it
@@ -113,7 +118,9 @@ struct ImuScene {
           RobotSetup{"/odo_" + id, "/" + id + "/scan", "/" + id + "/wheel_odom", "odom_" + id, "base_" + id,
                      "laser_" + id, Pose2D(0.1, 0.0, 0.0), path, hglasm_test::halfCircleLaser()});
       entry->robot->setWheelTurnScale(kWheelTurnScale);
-      if (entry != &w) entry->imu = std::make_unique<SimulatedImu>(nh, "/" + id + "/imu", "imu_" + id, path);
+      if (entry != &w) {
+        entry->imu = std::make_unique<ImuPublisher>(nh, "/" + id + "/imu", "imu_" + id, entry->robot->sim());
+      }
     }
   }
 

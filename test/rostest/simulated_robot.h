@@ -1,6 +1,7 @@
-// Shared by the rostest nodes that drive laser-odometry nodelets with a simulated robot: the robot (synthetic
-// scans of a polygonal room from test/core/test_util.h, wheel odometry, its laser mount on tf) and a
-// recorder of what the nodelets publish (~odom, ~pose, ~match, /rosout, /diagnostics, /tf).
+// Shared by the rostest nodes that drive laser-odometry nodelets with a simulated robot: the publishing
+// adapter of the tests' one simulated robot (test/core/simulated_robot.h: scans of a polygonal room, wheel
+// odometry, the laser mount, the gyro) and a recorder of what the nodelets publish (~odom, ~pose, ~match,
+// /rosout, /diagnostics, /tf).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -22,6 +24,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include "../core/simulated_robot.h"
 #include "../core/test_expect.h"
 #include "../core/test_util.h"
 #include "hglasm_odometry/Match.h"
@@ -33,7 +36,7 @@ namespace rostest_sim {
 using hglasm::Pose2D;
 using hglasm_test::deg;
 using hglasm_test::LaserSpec;
-using Path = std::function<Pose2D(double)>;
+using hglasm_test::Path;
 
 constexpr double kStampOrigin = 1000.0;  // scan stamps are kStampOrigin + simulated time (no sim time)
 
@@ -147,11 +150,9 @@ inline bool waitFor(const std::function<bool()>& done, double timeout) {
 
 // ------------------------------------------------------------------ one simulated robot + its odometry
 
-/// A LaserScan message of a laser at `laser_pose` in `world`.
-inline sensor_msgs::LaserScan scanMsg(const hglasm_test::World& world, const Pose2D& laser_pose,
-                                      const LaserSpec& laser, const ros::Time& stamp,
+/// The LaserScan message of simulated ranges.
+inline sensor_msgs::LaserScan scanMsg(const hglasm::RangeScan& ranges, const ros::Time& stamp,
                                       const std::string& frame) {
-  const hglasm::RangeScan ranges = hglasm_test::simulateRanges(world, laser_pose, laser);
   sensor_msgs::LaserScan msg;
   msg.header.stamp = stamp;
   msg.header.frame_id = frame;
@@ -163,6 +164,13 @@ inline sensor_msgs::LaserScan scanMsg(const hglasm_test::World& world, const Pos
   msg.scan_time = 0.1f;
   msg.ranges = ranges.ranges;
   return msg;
+}
+
+/// A LaserScan message of a laser at `laser_pose` in `world`.
+inline sensor_msgs::LaserScan scanMsg(const hglasm_test::World& world, const Pose2D& laser_pose,
+                                      const LaserSpec& laser, const ros::Time& stamp,
+                                      const std::string& frame) {
+  return scanMsg(hglasm_test::simulateRanges(world, laser_pose, laser), stamp, frame);
 }
 
 struct RobotSetup {
@@ -178,7 +186,10 @@ struct RobotSetup {
 class Robot {
  public:
   Robot(ros::NodeHandle& nh, RobotSetup setup)
-      : setup_(std::move(setup)), world_(hglasm_test::room()), wheels_(setup_.path, -1e9) {
+      : setup_(std::move(setup)), sim_(setup_.path, hglasm_test::room(), setup_.laser, -1e9) {
+    sim_.setMount(setup_.mount);
+    sim_.setWheelJump(-std::numeric_limits<double>::infinity(), Pose2D());  // setWheelOffset's, at any time
+    if (!setup_.wheel_topic.empty()) sim_.enableWheels();
     scan_pub_ = nh.advertise<sensor_msgs::LaserScan>(setup_.scan_topic, 100);
     if (!setup_.wheel_topic.empty()) wheel_pub_ = nh.advertise<nav_msgs::Odometry>(setup_.wheel_topic, 1000);
     odom_sub_ = nh.subscribe<nav_msgs::Odometry>(setup_.instance + "/odom", 10000,
@@ -198,7 +209,12 @@ class Robot {
   }
 
   const RobotSetup& setup() const { return setup_; }
-  void setLaser(const LaserSpec& laser) { setup_.laser = laser; }
+  void setLaser(const LaserSpec& laser) {
+    setup_.laser = laser;
+    sim_.setLaser(laser);
+  }
+  /// The simulation behind the messages (its gyro feeds the IMU rostest's publisher).
+  hglasm_test::SimulatedRobot& sim() { return sim_; }
 
   /// Subscribers of the nodelet connected to our publishers, and our subscribers to its outputs.
   bool connected() const {
@@ -207,12 +223,11 @@ class Robot {
            pose_sub_.getNumPublishers() > 0;
   }
 
-  Pose2D truth(double t) const { return setup_.path(t); }
+  Pose2D truth(double t) const { return sim_.truth(t); }
 
   /// The scan the laser takes at simulated time t (stamped `stamp`).
   sensor_msgs::LaserScan scanAt(double t, const ros::Time& stamp) const {
-    return scanMsg(world_, hglasm_test::composeByHand(truth(t), setup_.mount), setup_.laser, stamp,
-                   setup_.laser_frame);
+    return scanMsg(sim_.rangesAt(t), stamp, setup_.laser_frame);
   }
 
   /// Wheel odometry (exact, plus `wheel_offset` applied in the odometry frame; counting `wheel_turn_scale`
@@ -220,31 +235,39 @@ class Robot {
   /// (restarting if the stamps went back).
   void publishWheel(double t_until, const ros::Time& stamp_until) {
     if (!wheel_pub_) return;
+    // The timeline is mapped onto ros::Time here; the simulation's own stamp offset stays 0.
     const double stamp_offset = stamp_until.toSec() - t_until;
     // Restart when the stamps went back or onto another timeline (ros::Time rounds to nanoseconds: offsets
     // that differ by less are the same timeline).
-    if (wheels_.time() > t_until + 1e-9 || std::abs(stamp_offset - wheel_stamp_offset_) > 1e-6) {
-      wheels_.restart(t_until - 0.1);
+    hglasm_test::SimulatedWheels& wheels = sim_.wheels();
+    if (wheels.time() > t_until + 1e-9 || std::abs(stamp_offset - wheel_stamp_offset_) > 1e-6) {
+      wheels.restart(t_until - 0.1);
     }
     wheel_stamp_offset_ = stamp_offset;
-    wheels_.advance(t_until, [&](double time, const Pose2D& pose) {
+    hglasm_test::RobotSink sink;
+    sink.wheels = [&](double time, const Pose2D& pose) {
       nav_msgs::Odometry msg;
       msg.header.stamp = ros::Time(time + stamp_offset);
       msg.header.frame_id = "wheel_odom";
       msg.child_frame_id = setup_.base_frame;
-      msg.pose.pose = poseMsgFromPose2D(hglasm_test::composeByHand(wheel_offset_, pose));
+      msg.pose.pose = poseMsgFromPose2D(pose);
       wheel_pub_.publish(msg);
-    });
+    };
+    sim_.advanceWheels(t_until, sink);
   }
-  void setWheelOffset(const Pose2D& offset) { wheel_offset_ = offset; }
+  /// Wheel odometry offset by `offset` in the odometry frame, from the next sample on.
+  void setWheelOffset(const Pose2D& offset) {
+    sim_.setWheelJump(-std::numeric_limits<double>::infinity(), offset);
+  }
   /// Wheels that count `scale` of every turn (a skid-steer robot's slip), from the next sample on.
   void setWheelTurnScale(double scale) {
     // Slipping wheels integrate their own increments; exact ones are the truth itself (no rounding).
-    wheels_.restart(wheels_.time());
+    hglasm_test::SimulatedWheels& wheels = sim_.wheels();
+    wheels.restart(wheels.time());
     if (scale == 1.0) {
-      wheels_.setExact();
+      wheels.setExact();
     } else {
-      wheels_.setErrors(0.0, 0.0, scale);
+      wheels.setErrors(0.0, 0.0, scale);
     }
   }
 
@@ -302,16 +325,14 @@ class Robot {
 
  private:
   RobotSetup setup_;
-  hglasm_test::World world_;
+  hglasm_test::SimulatedRobot sim_;
   ros::Publisher scan_pub_, wheel_pub_;
   ros::Subscriber odom_sub_, pose_sub_, match_sub_;
   std::mutex mutex_;
   std::vector<nav_msgs::Odometry> odom_;
   std::vector<geometry_msgs::PoseWithCovarianceStamped> pose_;
   std::vector<Match> match_;
-  hglasm_test::SimulatedWheels wheels_;
   double wheel_stamp_offset_ = 0.0;
-  Pose2D wheel_offset_;
 };
 
 /// Clockwise circle of radius 1.5 m through the origin at 0.5 m/s (clear of the room's obstacles).
