@@ -27,6 +27,20 @@ struct NoiseLearnerOptions {
   double max_scan_scale = 1e4;
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, NoiseLearnerOptions* options) {
+  visitor.boolean("odometry/noise/learn", &options->learn_wheels);
+  visitor.positiveNumber("odometry/noise/learn_half_life", &options->half_life);
+  visitor.positiveInteger("odometry/noise/learn_lags", &options->lags);
+  visitor.positiveNumber("odometry/noise/min_scale", &options->min_wheel_scale);
+  visitor.positiveNumber("odometry/noise/max_scale", &options->max_wheel_scale);
+  visitor.boolean("scan_noise/learn", &options->learn_scan);
+  visitor.boolean("scan_noise/directional", &options->directional);
+  visitor.positiveNumber("scan_noise/min_scale", &options->min_scan_scale);
+  visitor.positiveNumber("scan_noise/max_scale", &options->max_scan_scale);
+}
+
 /// One matched scan as the learner sees it.
 struct NoiseSample {
   Pose2D scan_pose;  ///< where the scan alone put the base (odometry frame)
