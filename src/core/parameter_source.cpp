@@ -94,6 +94,13 @@ std::string ParameterValue::describe() const {
   return "a value of an unsupported type";
 }
 
+std::string constraintError(const std::string& prefix, const std::string& path, const std::string& relation,
+                            const std::string& other_path, const ParameterValue& other,
+                            const ParameterValue& got) {
+  return "parameter " + prefix + path + " must " + relation + " " + prefix + other_path + " (" +
+         other.describe() + "), got " + got.describe();
+}
+
 bool SubtreeSource::find(const std::string& path, ParameterValue* value) const {
   return source_.find(prefix_ + path, value);
 }

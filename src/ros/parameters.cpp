@@ -64,50 +64,20 @@ void collectLeaves(const XmlRpcValue& node, const std::string& path, std::vector
   }
 }
 
-std::string formatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
 /// Constraints between parameters, checked once all layers are applied.
 bool checkConsistency(const LaserOdometryOptions& options, std::string* error) {
   auto fail = [error](const std::string& message) {
     if (error) *error = message;
     return false;
   };
-  const hglasm::GeneticOptions& genetic = options.tracker.matcher.genetic;
-  if (genetic.elite_count >= genetic.population) {
-    return fail("parameter ~genetic/elite_count must be less than ~genetic/population (" +
-                std::to_string(genetic.population) + "), got " + std::to_string(genetic.elite_count));
-  }
-  if (genetic.coarse_generations > genetic.generations) {
-    return fail("parameter ~genetic/coarse_generations must not exceed ~genetic/generations (" +
-                std::to_string(genetic.generations) + "), got " + std::to_string(genetic.coarse_generations));
-  }
-  if (genetic.tournament_size > genetic.population) {
-    return fail("parameter ~genetic/tournament_size must not exceed ~genetic/population (" +
-                std::to_string(genetic.population) + "), got " + std::to_string(genetic.tournament_size));
-  }
-  const hglasm::NoiseLearnerOptions& learning = options.tracker.learning.noise;
-  if (learning.max_wheel_scale < learning.min_wheel_scale) {
-    return fail("parameter ~odometry/noise/max_scale must be at least ~odometry/noise/min_scale (" +
-                formatNumber(learning.min_wheel_scale) + "), got " + formatNumber(learning.max_wheel_scale));
-  }
-  if (learning.max_scan_scale < learning.min_scan_scale) {
-    return fail("parameter ~scan_noise/max_scale must be at least ~scan_noise/min_scale (" +
-                formatNumber(learning.min_scan_scale) + "), got " + formatNumber(learning.max_scan_scale));
-  }
-  const hglasm::ScanConversionOptions& conversion = options.tracker.conversion;
-  if (conversion.max_range <= conversion.min_range) {
-    return fail("parameter ~scan/max_range must be greater than ~scan/min_range (" +
-                formatNumber(conversion.min_range) + "), got " + formatNumber(conversion.max_range));
-  }
-  if (options.diagnostics.error_failure_ratio < options.diagnostics.warn_failure_ratio) {
-    return fail(
-        "parameter ~diagnostics/error_failure_ratio must be at least ~diagnostics/warn_failure_ratio (" +
-        formatNumber(options.diagnostics.warn_failure_ratio) + "), got " +
-        formatNumber(options.diagnostics.error_failure_ratio));
+  const std::string tracker = hglasm::inconsistency(options.tracker, "~");
+  if (!tracker.empty()) return fail(tracker);
+  const DiagnosticsOptions& diagnostics = options.diagnostics;
+  if (diagnostics.error_failure_ratio < diagnostics.warn_failure_ratio) {
+    return fail(hglasm::constraintError("~", "diagnostics/error_failure_ratio", "be at least",
+                                        "diagnostics/warn_failure_ratio",
+                                        ParameterValue::ofDouble(diagnostics.warn_failure_ratio),
+                                        ParameterValue::ofDouble(diagnostics.error_failure_ratio)));
   }
   if (options.odom_frame.empty() || options.base_frame.empty() || options.odom_frame == options.base_frame) {
     return fail("parameter ~base_frame must differ from ~odom_frame and neither may be \"/\", got \"" +

@@ -228,4 +228,17 @@ TEST(OptionWriter, WhatIsWrittenReadsBackUnchanged) {
   }
 }
 
+TEST(Inconsistency, NamesBothParametersAndTheirValuesOnceEveryLayerIsApplied) {
+  hglasm::TrackerOptions options;
+  EXPECT_EQ(hglasm::inconsistency(options, "~"), "");
+  options.matcher.genetic.elite_count = options.matcher.genetic.population;
+  EXPECT_EQ(hglasm::inconsistency(options, "~"),
+            "parameter ~genetic/elite_count must be less than ~genetic/population (100), got 100");
+  options = hglasm::TrackerOptions();
+  options.conversion.min_range = 5.0;
+  options.conversion.max_range = 2.5;
+  EXPECT_EQ(hglasm::inconsistency(options, "~"),
+            "parameter ~scan/max_range must be greater than ~scan/min_range (5), got 2.5");
+}
+
 }  // namespace

@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "hglasm_odometry/core/lookup_table.h"
@@ -69,6 +70,10 @@ void visitOptions(Visitor& visitor, GeneticOptions* options) {
   visitor.integer("genetic/seed", &seed, 0, std::numeric_limits<int>::max());
   options->seed = static_cast<std::uint64_t>(seed);
 }
+
+/// Constraints between its parameters, checked once every layer is applied: "" if met, else one line
+/// naming the parameter after `prefix` ("~").
+std::string inconsistency(const GeneticOptions& options, const std::string& prefix);
 
 /// How widely and how hard one alignment searches: the papers' Table 1 grows the box and the GA together.
 /// All zero by default: nothing searched.

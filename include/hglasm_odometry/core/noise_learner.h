@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <deque>
+#include <string>
 
 #include "hglasm_odometry/core/motion_model.h"
 #include "hglasm_odometry/core/pose2d.h"
@@ -40,6 +41,10 @@ void visitOptions(Visitor& visitor, NoiseLearnerOptions* options) {
   visitor.positiveNumber("scan_noise/min_scale", &options->min_scan_scale);
   visitor.positiveNumber("scan_noise/max_scale", &options->max_scan_scale);
 }
+
+/// Constraints between its parameters, checked once every layer is applied: "" if met, else one line
+/// naming the parameter after `prefix` ("~").
+std::string inconsistency(const NoiseLearnerOptions& options, const std::string& prefix);
 
 /// One matched scan as the learner sees it.
 struct NoiseSample {

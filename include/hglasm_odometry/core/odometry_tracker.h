@@ -89,6 +89,10 @@ void visitOptions(Visitor& visitor, TrackerOptions* options) {
   visitOptions(visitor, &options->matcher);
 }
 
+/// Constraints between its parameters, checked once every layer is applied: "" if met, else one line
+/// naming the parameter after `prefix` ("~").
+std::string inconsistency(const TrackerOptions& options, const std::string& prefix);
+
 /// How one scan was predicted, searched, matched and judged, and what is learned so far: for the node's
 /// Match message and diagnostics and for `evaluate --trace`.
 struct TrackerDiagnostics {

@@ -77,6 +77,13 @@ class ParameterTree : public ParameterSource {
   std::map<std::string, ParameterValue> values_;
 };
 
+/// "parameter ~genetic/elite_count must be less than ~genetic/population (100), got 100": a constraint
+/// between two parameters (`relation`: "be less than", "not exceed", ...), checked once every layer is
+/// applied.
+std::string constraintError(const std::string& prefix, const std::string& path, const std::string& relation,
+                            const std::string& other_path, const ParameterValue& other,
+                            const ParameterValue& got);
+
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 /// The ranges both visitors share: the reader validates them, the writer ignores them.

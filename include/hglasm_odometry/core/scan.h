@@ -50,6 +50,10 @@ void visitOptions(Visitor& visitor, ScanConversionOptions* options) {
   visitor.number("scan/sweep_time", &options->sweep_time, 0.0, kMaxSweepTime);
 }
 
+/// Constraints between its parameters, checked once every layer is applied: "" if met, else one line
+/// naming the parameter after `prefix` ("~").
+std::string inconsistency(const ScanConversionOptions& options, const std::string& prefix);
+
 /// Valid points of one scan in the sensor frame, in beam order.
 struct Scan {
   std::vector<Eigen::Vector2d> points;
