@@ -53,8 +53,8 @@ void visitOptions(Visitor& visitor, MatcherOptions* options) {
   visitOptions(visitor, &options->mbicp);
 }
 
-/// Each preset: the defaults above with the search space of the papers' Table 1 (config/presets.yaml holds
-/// the same values for ROS users).
+/// Each preset: the defaults above with the search space of the papers' Table 1 (config/presets.yaml lists
+/// what each changes, for ROS users).
 MatcherOptions presetOptions(Preset preset);
 
 enum class MatchStatus {
