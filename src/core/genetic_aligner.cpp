@@ -4,7 +4,26 @@
 #include <cmath>
 #include <numeric>
 
+#include "hglasm_odometry/core/parameter_source.h"
+
 namespace hglasm {
+
+std::string inconsistency(const GeneticOptions& options, const std::string& prefix) {
+  const auto integer = ParameterValue::ofInt;
+  if (options.elite_count >= options.population) {
+    return constraintError(prefix, "genetic/elite_count", "be less than", "genetic/population",
+                           integer(options.population), integer(options.elite_count));
+  }
+  if (options.coarse_generations > options.generations) {
+    return constraintError(prefix, "genetic/coarse_generations", "not exceed", "genetic/generations",
+                           integer(options.generations), integer(options.coarse_generations));
+  }
+  if (options.tournament_size > options.population) {
+    return constraintError(prefix, "genetic/tournament_size", "not exceed", "genetic/population",
+                           integer(options.population), integer(options.tournament_size));
+  }
+  return "";
+}
 namespace {
 
 std::uint64_t grayToBinary(std::uint64_t gray) {

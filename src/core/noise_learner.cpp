@@ -4,7 +4,22 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hglasm_odometry/core/parameter_source.h"
+
 namespace hglasm {
+
+std::string inconsistency(const NoiseLearnerOptions& options, const std::string& prefix) {
+  const auto number = ParameterValue::ofDouble;
+  if (options.max_wheel_scale < options.min_wheel_scale) {
+    return constraintError(prefix, "odometry/noise/max_scale", "be at least", "odometry/noise/min_scale",
+                           number(options.min_wheel_scale), number(options.max_wheel_scale));
+  }
+  if (options.max_scan_scale < options.min_scan_scale) {
+    return constraintError(prefix, "scan_noise/max_scale", "be at least", "scan_noise/min_scale",
+                           number(options.min_scan_scale), number(options.max_scan_scale));
+  }
+  return "";
+}
 namespace {
 
 // A whitened innovation may count at most this many times what the model expects, so one bad match (a

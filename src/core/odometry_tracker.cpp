@@ -9,6 +9,15 @@
 #include "hglasm_odometry/core/deskew.h"
 
 namespace hglasm {
+
+std::string inconsistency(const TrackerOptions& options, const std::string& prefix) {
+  for (const std::string& error :
+       {inconsistency(options.matcher.genetic, prefix), inconsistency(options.learning.noise, prefix),
+        inconsistency(options.conversion, prefix)}) {
+    if (!error.empty()) return error;
+  }
+  return "";
+}
 namespace {
 
 bool matchUsable(const MatchResult& match) {

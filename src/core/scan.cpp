@@ -3,7 +3,18 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hglasm_odometry/core/parameter_source.h"
+
 namespace hglasm {
+
+std::string inconsistency(const ScanConversionOptions& options, const std::string& prefix) {
+  if (options.max_range <= options.min_range) {
+    return constraintError(prefix, "scan/max_range", "be greater than", "scan/min_range",
+                           ParameterValue::ofDouble(options.min_range),
+                           ParameterValue::ofDouble(options.max_range));
+  }
+  return "";
+}
 
 const char* toString(ScanError error) {
   switch (error) {

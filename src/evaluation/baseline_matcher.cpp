@@ -72,8 +72,13 @@ BaselineOptions baselineOptions(Algorithm algorithm, Preset preset) {
   BaselineOptions options;
   options.algorithm = algorithm;
   options.matcher = presetOptions(preset);
-  options.pga.pairing_threshold = options.matcher.table.cutoff;
-  options.pga.coarse_pairing_threshold = options.matcher.coarse_table.cutoff;
+  return options;
+}
+
+PolarPairingOptions polarPairingOptions(const MatcherOptions& matcher) {
+  PolarPairingOptions options;
+  options.pairing_threshold = matcher.table.cutoff;
+  options.coarse_pairing_threshold = matcher.coarse_table.cutoff;
   return options;
 }
 
@@ -83,7 +88,7 @@ BaselineMatcher::BaselineMatcher(const BaselineOptions& options)
       coarse_table_(options.matcher.coarse_table, kernelOf(options.algorithm)),
       aligner_(options.matcher.genetic),
       mbicp_(options.matcher.mbicp),
-      polar_pairing_(options.pga) {}
+      polar_pairing_(polarPairingOptions(options.matcher)) {}
 
 void BaselineMatcher::setReference(const Scan& scan) {
   ReferencePoints reference;

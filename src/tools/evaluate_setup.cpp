@@ -1,11 +1,12 @@
 #include "hglasm_odometry/tools/evaluate_setup.h"
 
+#include <algorithm>
+
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 
 #include <ros/package.h>
-#include <xmlrpcpp/XmlRpcValue.h>
 
 #include "hglasm_odometry/core/cpu_time.h"
 #include "hglasm_odometry/tools/yaml_parameters.h"
@@ -44,6 +45,14 @@ const char kUsage[] =
     "  --quiet                 no per-warning output\n";
 
 bool exists(const std::string& path) { return std::ifstream(path).good(); }
+
+/// Whether every parameter of `tree` is `key` or below it (and there is one).
+bool onlyKey(const hglasm::ParameterTree& tree, const std::string& key) {
+  const auto& values = tree.values();
+  return !values.empty() && std::all_of(values.begin(), values.end(), [&key](const auto& entry) {
+    return entry.first == key || entry.first.compare(0, key.size() + 1, key + "/") == 0;
+  });
+}
 
 }  // namespace
 
@@ -117,18 +126,22 @@ std::string presetsNextTo(const std::string& config) {
 
 bool loadEvaluateOptions(const EvaluateArguments& args, LaserOdometryOptions* options,
                          std::vector<std::string>* warnings, bool* config_found, std::string* error) {
-  XmlRpc::XmlRpcValue root, presets;
+  hglasm::ParameterTree root, presets;
   *config_found = args.config_given || exists(args.config);
   if (*config_found && !loadYamlParameters(args.config, &root, error)) return false;
   const std::string presets_path = args.presets.empty() ? presetsNextTo(args.config) : args.presets;
   if (args.presets_given || exists(presets_path)) {
     if (!loadYamlParameters(presets_path, &presets, error)) return false;
     // Accept a presets file written either as {small: ..} or as {presets: {small: ..}}.
-    if (presets.size() == 1 && presets.hasMember("presets"))
-      presets = XmlRpc::XmlRpcValue(presets["presets"]);
-    root["presets"] = presets;
+    hglasm::ParameterValue nested;
+    if (onlyKey(presets, "presets") && presets.find("presets", &nested) &&
+        nested.type != hglasm::ParameterValue::Type::kDictionary) {
+      root.set("presets", nested);  // not a dictionary: the loader says so
+    } else {
+      root.setTree("presets", onlyKey(presets, "presets") ? presets.subtree("presets") : presets);
+    }
   }
-  if (!args.preset.empty()) root["preset"] = args.preset;
+  if (!args.preset.empty()) root.set("preset", hglasm::ParameterValue::ofString(args.preset));
   return loadOptions(root, options, error, warnings);
 }
 

@@ -14,7 +14,8 @@
 namespace hglasm_odometry {
 namespace {
 
-using XmlRpc::XmlRpcValue;
+using hglasm::ParameterTree;
+using hglasm::ParameterValue;
 
 // PyYAML's resolvers (yaml/resolver.py) for the forms read here; a float needs a dot (1e-3 is a string).
 const std::regex kTrue("yes|Yes|YES|true|True|TRUE|on|On|ON");
@@ -35,19 +36,19 @@ struct Failure : std::runtime_error {
 };
 
 /// A scalar typed as rosparam types it: quoted and block scalars are strings, plain ones are resolved.
-XmlRpcValue scalarOf(const YAML::Node& node, const std::string& key) {
+ParameterValue scalarOf(const YAML::Node& node, const std::string& key) {
   const std::string& text = node.Scalar();
-  if (node.Tag() == "!") return XmlRpcValue(text);
+  if (node.Tag() == "!") return ParameterValue::ofString(text);
   if (node.Tag() != "?") throw Failure(node, key, "unsupported tag '" + node.Tag() + "'");
   std::smatch angle;
-  if (std::regex_match(text, kTrue)) return XmlRpcValue(true);
-  if (std::regex_match(text, kFalse)) return XmlRpcValue(false);
-  if (std::regex_match(text, kFloat)) return XmlRpcValue(std::strtod(text.c_str(), nullptr));
+  if (std::regex_match(text, kTrue)) return ParameterValue::ofBool(true);
+  if (std::regex_match(text, kFalse)) return ParameterValue::ofBool(false);
+  if (std::regex_match(text, kFloat)) return ParameterValue::ofDouble(std::strtod(text.c_str(), nullptr));
   if (std::regex_match(text, kSpecial)) {
     const double inf = std::numeric_limits<double>::infinity();
-    return XmlRpcValue(text.find_first_of("aA") != std::string::npos ? std::nan("")
-                       : text[0] == '-'                              ? -inf
-                                                                     : inf);
+    return ParameterValue::ofDouble(text.find_first_of("aA") != std::string::npos ? std::nan("")
+                                    : text[0] == '-'                              ? -inf
+                                                                                  : inf);
   }
   if (std::regex_match(text, kInt)) {
     errno = 0;
@@ -55,11 +56,11 @@ XmlRpcValue scalarOf(const YAML::Node& node, const std::string& key) {
     if (errno == ERANGE || value < INT_MIN || value > INT_MAX) {
       throw Failure(node, key, "'" + text + "' is not a 32-bit int (the parameter server's)");
     }
-    return XmlRpcValue(static_cast<int>(value));
+    return ParameterValue::ofInt(static_cast<int>(value));
   }
   if (std::regex_match(text, angle, kAngle)) {
     const double value = std::strtod(angle[2].str().c_str(), nullptr);
-    return XmlRpcValue(angle[1] == "deg" ? value * M_PI / 180.0 : value);
+    return ParameterValue::ofDouble(angle[1] == "deg" ? value * M_PI / 180.0 : value);
   }
   if (std::regex_match(text, kRefused)) {
     throw Failure(node, key,
@@ -67,42 +68,51 @@ XmlRpcValue scalarOf(const YAML::Node& node, const std::string& key) {
                       "' is not read here as rosparam reads it: quote a string; write numbers as "
                       "decimal ints, floats with a dot (1.0e-3, not 1e-3), deg(N) or rad(N); no merge keys");
   }
-  return XmlRpcValue(text);
+  return ParameterValue::ofString(text);
 }
 
-XmlRpcValue valueOf(const YAML::Node& node, const std::string& key) {
-  XmlRpcValue value;
-  switch (node.Type()) {
-    case YAML::NodeType::Map:
-      value.begin();  // an empty mapping is an empty struct
-      for (const auto& entry : node) {
-        const std::string name = entry.first.IsScalar() ? entry.first.Scalar() : "?";
-        if (key.empty() && name == "_ns") continue;  // rosparam's namespace key
-        const std::string path = key.empty() ? name : key + "/" + name;
-        if (!entry.first.IsScalar() || scalarOf(entry.first, path).getType() != XmlRpcValue::TypeString) {
-          throw Failure(entry.first, path, "a key must be a string: quote it");
-        }
-        value[name] = valueOf(entry.second, path);  // a repeated key replaces the earlier value
-      }
-      return value;
-    case YAML::NodeType::Sequence:
-      value.setSize(static_cast<int>(node.size()));
-      for (std::size_t i = 0; i < node.size(); ++i) {
-        value[static_cast<int>(i)] = valueOf(node[i], key + "[" + std::to_string(i) + "]");
-      }
-      return value;
-    case YAML::NodeType::Scalar:
-      return scalarOf(node, key);
-    case YAML::NodeType::Null:
-    case YAML::NodeType::Undefined:
-      break;
+ParameterValue valueOf(const YAML::Node& node, const std::string& key);
+
+/// A mapping's parameters by path below it (`key`: its own path, for messages).
+ParameterTree treeOf(const YAML::Node& node, const std::string& key) {
+  ParameterTree tree;
+  for (const auto& entry : node) {
+    const std::string name = entry.first.IsScalar() ? entry.first.Scalar() : "?";
+    if (key.empty() && name == "_ns") continue;  // rosparam's namespace key
+    const std::string path = key.empty() ? name : key + "/" + name;
+    if (!entry.first.IsScalar() || scalarOf(entry.first, path).type != ParameterValue::Type::kString) {
+      throw Failure(entry.first, path, "a key must be a string: quote it");
+    }
+    if (entry.second.IsMap()) {  // a repeated key replaces the earlier value
+      tree.setTree(name, treeOf(entry.second, path));
+    } else {
+      tree.set(name, valueOf(entry.second, path));
+    }
   }
-  throw Failure(node, key, "a null value (~, null or nothing): the parameter server cannot hold it");
+  return tree;
+}
+
+/// A value that is not a mapping's own entry: a list keeps its items; a mapping in a list is checked, its
+/// type kept (no option is a list).
+ParameterValue valueOf(const YAML::Node& node, const std::string& key) {
+  if (node.IsScalar()) return scalarOf(node, key);
+  if (node.IsMap()) {
+    treeOf(node, key);
+    return ParameterValue::ofType(ParameterValue::Type::kDictionary);
+  }
+  if (!node.IsSequence()) {
+    throw Failure(node, key, "a null value (~, null or nothing): the parameter server cannot hold it");
+  }
+  ParameterValue list = ParameterValue::ofType(ParameterValue::Type::kList);
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    list.items.push_back(valueOf(node[i], key + "[" + std::to_string(i) + "]"));
+  }
+  return list;
 }
 
 }  // namespace
 
-bool loadYamlParameters(const std::string& path, XmlRpcValue* value, std::string* error) {
+bool loadYamlParameters(const std::string& path, ParameterTree* tree, std::string* error) {
   if (!std::ifstream(path)) {
     *error = "cannot read " + path;
     return false;
@@ -113,9 +123,7 @@ bool loadYamlParameters(const std::string& path, XmlRpcValue* value, std::string
       *error = path + " does not hold a dictionary of parameters";
       return false;
     }
-    *value = XmlRpcValue();
-    value->begin();  // an empty file: no parameters
-    if (root.IsMap()) *value = valueOf(root, "");
+    *tree = root.IsMap() ? treeOf(root, "") : ParameterTree();  // an empty file: no parameters
     return true;
   } catch (const YAML::Exception& exception) {
     *error = path + ":" + std::to_string(exception.mark.line + 1) + ":" +

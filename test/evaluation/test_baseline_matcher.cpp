@@ -77,9 +77,19 @@ TEST(BaselineMatcher, OptionsAreThePresetsWithPgaWithinTheTablesReach) {
     EXPECT_EQ(baseline.matcher.genetic.population, matcher.genetic.population);
     EXPECT_EQ(baseline.matcher.genetic.coarse_generations, matcher.genetic.coarse_generations);
     EXPECT_EQ(baseline.matcher.coarse_table.cutoff, matcher.coarse_table.cutoff);
-    EXPECT_EQ(baseline.pga.pairing_threshold, matcher.table.cutoff);
-    EXPECT_EQ(baseline.pga.coarse_pairing_threshold, matcher.coarse_table.cutoff);
+    const hglasm::PolarPairingOptions pairing = hglasm::polarPairingOptions(baseline.matcher);
+    EXPECT_EQ(pairing.pairing_threshold, matcher.table.cutoff);
+    EXPECT_EQ(pairing.coarse_pairing_threshold, matcher.coarse_table.cutoff);
   }
+}
+
+TEST(BaselineMatcher, AnOverriddenTableCutoffReachesPgasPairing) {
+  hglasm::BaselineOptions baseline = hglasm::baselineOptions(Algorithm::kPga, Preset::kMedium);
+  baseline.matcher.table.cutoff = 0.45;
+  baseline.matcher.coarse_table.cutoff = 0.9;
+  const hglasm::BaselineMatcher matcher(baseline);
+  EXPECT_EQ(matcher.polarPairing().options().pairing_threshold, 0.45);
+  EXPECT_EQ(matcher.polarPairing().options().coarse_pairing_threshold, 0.9);
 }
 
 // ------------------------------------------------------------------ binary GLASM's table

@@ -136,7 +136,7 @@ int pgaRecoveries(hglasm::Preset preset, const hglasm_test::LaserSpec& laser, in
   const hglasm_test::World world = hglasm_test::room();
   const hglasm::BaselineOptions baseline = hglasm::baselineOptions(hglasm::Algorithm::kPga, preset);
   const hglasm::MatcherOptions& matcher = baseline.matcher;
-  PolarPairing pairing(baseline.pga);
+  PolarPairing pairing(hglasm::polarPairingOptions(matcher));
   pairing.build(referenceOf(hglasm_test::simulateScan(world, Pose2D(), laser)));
   std::mt19937 rng(99);
   std::uniform_real_distribution<double> unit(-0.9, 0.9);

@@ -1,6 +1,7 @@
 // loadYamlParameters gives exactly what rosparam gives (the same types, the same bits) on the shipped
 // configuration and on a file of every kind of scalar it reads, and an error naming the key on what it
-// refuses (what rosparam would read otherwise or the parameter server cannot hold).
+// refuses (what rosparam would read otherwise or the parameter server cannot hold); the nodelet's loader
+// reads its parameters.
 #include "hglasm_odometry/tools/yaml_parameters.h"
 
 #include <gtest/gtest.h>
@@ -10,13 +11,18 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "hglasm_odometry/ros/parameters.h"
 
 namespace hglasm_odometry {
 namespace {
 
+using hglasm::ParameterValue;
+using Type = hglasm::ParameterValue::Type;
 using XmlRpc::XmlRpcValue;
 
 const std::string kSourceDir = HGLASM_SOURCE_DIR;
@@ -42,46 +48,70 @@ bool loadWithRosparam(const std::string& path, XmlRpcValue* value, std::string* 
   return value->valid();
 }
 
-/// Empty if equal in type and value (doubles bit for bit, NaN equal to NaN), else the first difference.
-std::string difference(const XmlRpcValue& expected_const, const XmlRpcValue& actual_const,
+/// Empty if `actual` equals rosparam's `expected_const` in type and value (doubles bit for bit, NaN equal to
+/// NaN), else the difference. A dictionary's contents are compared by path (treeDifference); one inside a
+/// list by its type alone (no option is a list).
+std::string difference(const XmlRpcValue& expected_const, const ParameterValue& actual,
                        const std::string& path) {
-  XmlRpcValue expected = expected_const, actual = actual_const;  // the typed accessors are not const
-  if (expected.getType() != actual.getType()) {
-    return path + ": type " + std::to_string(actual.getType()) + ", rosparam " +
-           std::to_string(expected.getType()) + " (" + expected.toXml() + " vs " + actual.toXml() + ")";
-  }
+  XmlRpcValue expected = expected_const;  // the typed accessors are not const
+  const std::string differs = path + ": " + actual.describe() + ", rosparam " + expected.toXml();
   switch (expected.getType()) {
+    case XmlRpcValue::TypeBoolean:
+      return actual.type == Type::kBool && actual.boolean == static_cast<bool>(expected) ? "" : differs;
+    case XmlRpcValue::TypeInt:
+      return actual.type == Type::kInt && actual.integer == static_cast<int>(expected) ? "" : differs;
+    case XmlRpcValue::TypeString:
+      return actual.type == Type::kString && actual.text == static_cast<std::string>(expected) ? "" : differs;
     case XmlRpcValue::TypeDouble: {
-      const double a = expected, b = actual;
+      const double a = expected, b = actual.number;
       const bool same = (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof(double)) == 0;
-      return same ? "" : path + ": " + actual.toXml() + ", rosparam " + expected.toXml();
+      return actual.type == Type::kDouble && same ? "" : differs;
     }
     case XmlRpcValue::TypeArray:
-      if (expected.size() != actual.size()) return path + ": list sizes differ";
+      if (actual.type != Type::kList || static_cast<int>(actual.items.size()) != expected.size())
+        return differs;
       for (int i = 0; i < expected.size(); ++i) {
-        const std::string inner = difference(expected[i], actual[i], path + "[" + std::to_string(i) + "]");
+        const std::string inner =
+            difference(expected[i], actual.items[i], path + "[" + std::to_string(i) + "]");
         if (!inner.empty()) return inner;
       }
       return "";
     case XmlRpcValue::TypeStruct:
-      if (expected.size() != actual.size()) return path + ": mapping sizes differ";
-      for (auto& entry : expected) {
-        if (!actual.hasMember(entry.first)) return path + "/" + entry.first + ": missing";
-        const std::string inner = difference(entry.second, actual[entry.first], path + "/" + entry.first);
-        if (!inner.empty()) return inner;
-      }
-      return "";
+      return actual.type == Type::kDictionary ? "" : differs;
     default:
-      return expected == actual ? "" : path + ": " + actual.toXml() + ", rosparam " + expected.toXml();
+      return differs;
   }
 }
 
+/// Empty if `actual` holds exactly rosparam's parameters `expected`, else the first difference.
+std::string treeDifference(const XmlRpcValue& expected, const hglasm::ParameterTree& actual) {
+  const std::vector<std::string> want = XmlRpcParameterSource(expected).leafPaths(), got = actual.leafPaths();
+  if (std::set<std::string>(want.begin(), want.end()) != std::set<std::string>(got.begin(), got.end())) {
+    return "the parameters' paths differ";
+  }
+  std::vector<std::pair<std::string, const XmlRpcValue*>> stack = {{"", &expected}};
+  while (!stack.empty()) {
+    const auto [path, node] = stack.back();
+    stack.pop_back();
+    for (auto it = node->begin(); it != node->end(); ++it) {
+      const std::string child = path.empty() ? it->first : path + "/" + it->first;
+      ParameterValue value;
+      if (!actual.find(child, &value)) return child + ": missing";
+      const std::string inner = difference(it->second, value, child);
+      if (!inner.empty()) return inner;
+      if (it->second.getType() == XmlRpcValue::TypeStruct) stack.emplace_back(child, &it->second);
+    }
+  }
+  return "";
+}
+
 void expectSameAsRosparam(const std::string& path) {
-  XmlRpcValue reference, loaded;
+  XmlRpcValue reference;
+  hglasm::ParameterTree loaded;
   std::string output, error;
   if (!loadWithRosparam(path, &reference, &output)) GTEST_SKIP() << "rosparam not usable: " << output;
   ASSERT_TRUE(loadYamlParameters(path, &loaded, &error)) << error;
-  EXPECT_EQ(difference(reference, loaded, path), "");
+  EXPECT_EQ(treeDifference(reference, loaded), "");
 }
 
 TEST(YamlParameters, ShippedConfigurationIsReadAsRosparamReadsIt) {
@@ -96,36 +126,64 @@ TEST(YamlParameters, EveryKindOfScalarIsTypedAsRosparamTypesIt) {
   expectSameAsRosparam(kSourceDir + "/test/data/yaml_types.yaml");
 }
 
+/// The value at `path`, or a kOther value if absent.
+ParameterValue at(const hglasm::ParameterSource& source, const std::string& path) {
+  ParameterValue value;
+  EXPECT_TRUE(source.find(path, &value)) << path;
+  return value;
+}
+
 TEST(YamlParameters, ShippedConfigurationKeepsIntsBoolsDoublesAndStrings) {
-  XmlRpcValue root;
+  hglasm::ParameterTree root;
   std::string error;
   ASSERT_TRUE(loadYamlParameters(kSourceDir + "/config/laser_odometry.yaml", &root, &error)) << error;
-  EXPECT_EQ(root["queue_size"].getType(), XmlRpcValue::TypeInt);
-  EXPECT_EQ(static_cast<int>(root["queue_size"]), 5);
-  EXPECT_EQ(root["tf_warn_period"].getType(), XmlRpcValue::TypeDouble);
-  EXPECT_EQ(root["publish_tf"].getType(), XmlRpcValue::TypeBoolean);
-  EXPECT_EQ(static_cast<std::string>(root["preset"]), "medium");
-  EXPECT_EQ(root["scan"]["max_range"].getType(), XmlRpcValue::TypeDouble);
-  EXPECT_TRUE(std::isinf(static_cast<double>(root["scan"]["max_range"])));
-  EXPECT_EQ(root["odometry"]["noise"]["learn"].getType(), XmlRpcValue::TypeBoolean);
+  EXPECT_EQ(at(root, "queue_size").type, Type::kInt);
+  EXPECT_EQ(at(root, "queue_size").integer, 5);
+  EXPECT_EQ(at(root, "tf_warn_period").type, Type::kDouble);
+  EXPECT_EQ(at(root, "publish_tf").type, Type::kBool);
+  EXPECT_EQ(at(root, "preset").text, "medium");
+  EXPECT_EQ(at(root, "scan/max_range").type, Type::kDouble);
+  EXPECT_TRUE(std::isinf(at(root, "scan/max_range").number));
+  EXPECT_EQ(at(root, "odometry/noise/learn").type, Type::kBool);
+  EXPECT_EQ(at(root, "odometry/noise").type, Type::kDictionary);
+}
 
-  XmlRpcValue presets;
-  ASSERT_TRUE(loadYamlParameters(kSourceDir + "/config/presets.yaml", &presets, &error)) << error;
-  EXPECT_EQ(static_cast<double>(presets["medium"]["mbicp"]["degenerate_eigenvalue"]), 1.0e-06);
-  EXPECT_EQ(presets["medium"]["genetic"]["population"].getType(), XmlRpcValue::TypeInt);
+TEST(YamlParameters, AnglesOfANumberAreRadians) {
+  const std::string path = testing::TempDir() + "hglasm_angles.yaml";
+  std::ofstream(path) << "a: deg(80)\nb: deg( -45 )\nc: rad(1.5)\nd: \"deg(80)\"\n";
+  hglasm::ParameterTree tree;
+  std::string error;
+  ASSERT_TRUE(loadYamlParameters(path, &tree, &error)) << error;
+  std::remove(path.c_str());
+  EXPECT_EQ(at(tree, "a").number, 80.0 * M_PI / 180.0);
+  EXPECT_EQ(at(tree, "b").number, -45.0 * M_PI / 180.0);
+  EXPECT_EQ(at(tree, "c").number, 1.5);
+  EXPECT_EQ(at(tree, "d").type, Type::kString);  // quoted: a string, as rosparam reads it
 }
 
 TEST(YamlParameters, ShippedConfigurationLoadsIntoTheNodeletOptions) {
-  XmlRpcValue root, presets;
+  hglasm::ParameterTree root, presets;
   std::string error;
   ASSERT_TRUE(loadYamlParameters(kSourceDir + "/config/laser_odometry.yaml", &root, &error)) << error;
   ASSERT_TRUE(loadYamlParameters(kSourceDir + "/config/presets.yaml", &presets, &error)) << error;
-  root["presets"] = presets;
+  root.setTree("presets", presets);
   LaserOdometryOptions options;
   std::vector<std::string> warnings;
   ASSERT_TRUE(loadOptions(root, &options, &error, &warnings)) << error;
   EXPECT_TRUE(warnings.empty()) << warnings.front();
   EXPECT_EQ(options.preset, "medium");
+}
+
+TEST(YamlParameters, AnOptionsTypeErrorNamesTheParameterAsTheNodeletDoes) {
+  const std::string path = testing::TempDir() + "hglasm_wrong_type.yaml";
+  std::ofstream(path) << "genetic:\n  population: deg(80)\n";
+  hglasm::ParameterTree root;
+  std::string error;
+  ASSERT_TRUE(loadYamlParameters(path, &root, &error)) << error;
+  std::remove(path.c_str());
+  LaserOdometryOptions options;
+  EXPECT_FALSE(loadOptions(root, &options, &error));
+  EXPECT_EQ(error, "parameter ~genetic/population must be an integer in [2, 100000], got 1.39626");
 }
 
 std::string writeFile(const std::string& name, const std::string& text) {
@@ -136,7 +194,7 @@ std::string writeFile(const std::string& name, const std::string& text) {
 
 std::string loadError(const std::string& name, const std::string& text) {
   const std::string path = writeFile(name, text);
-  XmlRpcValue value;
+  hglasm::ParameterTree value;
   std::string error;
   EXPECT_FALSE(loadYamlParameters(path, &value, &error));
   std::remove(path.c_str());
@@ -182,7 +240,7 @@ TEST(YamlParameters, ScalarsRosparamWouldReadOtherwiseAreErrors) {
 }
 
 TEST(YamlParameters, MissingFileIsAnError) {
-  XmlRpcValue value;
+  hglasm::ParameterTree value;
   std::string error;
   EXPECT_FALSE(loadYamlParameters("/nonexistent/params.yaml", &value, &error));
   EXPECT_EQ(error, "cannot read /nonexistent/params.yaml");
@@ -190,12 +248,11 @@ TEST(YamlParameters, MissingFileIsAnError) {
 
 TEST(YamlParameters, EmptyFileHoldsNoParameters) {
   const std::string path = writeFile("hglasm_empty.yaml", "# only a comment\n");
-  XmlRpcValue value;
+  hglasm::ParameterTree value;
   std::string error;
   ASSERT_TRUE(loadYamlParameters(path, &value, &error)) << error;
   std::remove(path.c_str());
-  EXPECT_EQ(value.getType(), XmlRpcValue::TypeStruct);
-  EXPECT_EQ(value.size(), 0);
+  EXPECT_TRUE(value.values().empty());
 }
 
 }  // namespace

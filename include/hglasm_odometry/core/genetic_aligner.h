@@ -2,9 +2,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "hglasm_odometry/core/lookup_table.h"
@@ -45,6 +48,32 @@ struct GeneticOptions {
   int coarse_generations = 3;
   std::uint64_t seed = 1;
 };
+
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, GeneticOptions* options) {
+  visitor.positiveNumber("genetic/box_x", &options->box.half_x);
+  visitor.positiveNumber("genetic/box_y", &options->box.half_y);
+  visitor.number("genetic/box_theta", &options->box.half_theta, 0.0, M_PI, true);
+  visitor.integer("genetic/population", &options->population, 2, 100000);
+  visitor.positiveInteger("genetic/generations", &options->generations);
+  visitor.positiveInteger("genetic/runs", &options->runs);
+  visitor.integer("genetic/bits_per_gene", &options->bits_per_gene, 2, 20);
+  visitor.fraction("genetic/crossover_rate", &options->crossover_rate);
+  visitor.fraction("genetic/mutation_rate", &options->mutation_rate);
+  visitor.positiveInteger("genetic/tournament_size", &options->tournament_size);
+  visitor.integer("genetic/elite_count", &options->elite_count, 1, 100000);
+  visitor.integer("genetic/max_points", &options->max_points, 0, 1000000);
+  visitor.integer("genetic/polish_evaluations", &options->polish_evaluations, 0, 1000000);
+  visitor.integer("genetic/coarse_generations", &options->coarse_generations, 0, 100000);
+  int seed = static_cast<int>(options->seed);  // a parameter holds 32-bit ints
+  visitor.integer("genetic/seed", &seed, 0, std::numeric_limits<int>::max());
+  options->seed = static_cast<std::uint64_t>(seed);
+}
+
+/// Constraints between its parameters, checked once every layer is applied: "" if met, else one line
+/// naming the parameter after `prefix` ("~").
+std::string inconsistency(const GeneticOptions& options, const std::string& prefix);
 
 /// How widely and how hard one alignment searches: the papers' Table 1 grows the box and the GA together.
 /// All zero by default: nothing searched.

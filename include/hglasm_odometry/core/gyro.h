@@ -29,6 +29,18 @@ struct GyroOptions {
   double bias_random_walk = 1e-4;
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, GyroOptions* options) {
+  visitor.boolean("imu/use_orientation", &options->use_orientation);
+  visitor.number("imu/max_gap", &options->max_gap, 0.0, 10.0, true);
+  visitor.nonNegativeNumber("imu/noise/angle_random_walk", &options->angle_random_walk);
+  visitor.nonNegativeNumber("imu/noise/bias_sigma", &options->bias_sigma);
+  visitor.nonNegativeNumber("imu/noise/scale_error", &options->scale_error);
+  visitor.boolean("imu/noise/estimate_bias", &options->estimate_bias);
+  visitor.nonNegativeNumber("imu/noise/bias_random_walk", &options->bias_random_walk);
+}
+
 /// Variance (rad^2) of a gyro rotation of `angle` radians over `dt` seconds under `options`' noise model,
 /// with a bias known to `bias_variance` ((rad/s)^2; bias_sigma squared before anything is learned).
 double gyroRotationVariance(const GyroOptions& options, double angle, double dt, double bias_variance);

@@ -4,6 +4,7 @@
 // increment, range limits) is points like any other: no reason for a keyframe.
 #pragma once
 
+#include <cmath>
 #include "hglasm_odometry/core/pose2d.h"
 
 namespace hglasm {
@@ -13,6 +14,14 @@ struct KeyframeOptions {
   double angle = 0.20;       ///< radians turned since the keyframe that make a new keyframe
   double min_fitness = 0.0;  ///< a published pose below this fitness ratio makes the scan a keyframe
 };
+
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, KeyframeOptions* options) {
+  visitor.positiveNumber("keyframe/distance", &options->distance);
+  visitor.number("keyframe/angle", &options->angle, 0.0, M_PI, true);
+  visitor.fraction("keyframe/min_fitness", &options->min_fitness);
+}
 
 /// A processed scan as the policy sees it.
 struct KeyframeCandidate {

@@ -36,6 +36,17 @@ struct LeapOptions {
   double confirm_below = 1e-3;  ///< the prior odds of a leap, as `probability`
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, LeapOptions* options) {
+  visitor.positiveNumber("leap/max_mahalanobis", &options->max_mahalanobis);
+  visitor.number("leap/probability", &options->probability, 0.0, 0.5, true);
+  visitor.number("leap/persistence", &options->persistence, 0.0, 1.0, true);
+  visitor.number("leap/likelihood_outlier", &options->likelihood_outlier, 0.0, 1.0, true);
+  visitor.boolean("leap/confirm", &options->confirm);
+  visitor.number("leap/confirm_below", &options->confirm_below, 0.0, 1.0, true);
+}
+
 /// The two hypotheses a scan is matched under, in the local map's frame (the laser's pose).
 struct LeapHypotheses {
   PosePrior prior;  ///< the prediction holds

@@ -34,6 +34,15 @@ struct LocalMapOptions {
   double reframe_distance = 1.0;
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, LocalMapOptions* options) {
+  visitor.positiveInteger("local_map/keyframes", &options->keyframes);
+  visitor.positiveNumber("local_map/max_distance", &options->max_distance);
+  visitor.nonNegativeNumber("local_map/resolution", &options->resolution);
+  visitor.nonNegativeNumber("local_map/reframe_distance", &options->reframe_distance);
+}
+
 /// Keyframes (points in their laser frame, laser pose in the odometry frame) gathered into submaps, each in
 /// its first keyframe's frame with its lookup tables; the matched submap's points are offered in the newest
 /// keyframe's frame too (MbICP's reference, whose metric wants the sensor near the origin). Not thread-safe

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -33,6 +35,19 @@ struct LookupTableOptions {
   double isolated_footprint = 1.0;
   SurfaceOptions surface() const { return SurfaceOptions{segment_max_gap, segment_max_incidence}; }
 };
+
+/// Its parameters under `prefix` ("table/", "coarse_table/") with their valid ranges, for OptionReader and
+/// OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, const std::string& prefix, LookupTableOptions* options) {
+  visitor.positiveNumber(prefix + "cell_size", &options->cell_size);
+  visitor.positiveNumber(prefix + "sigma", &options->sigma);
+  visitor.positiveNumber(prefix + "cutoff", &options->cutoff);
+  visitor.number(prefix + "segment_max_gap", &options->segment_max_gap, 0.0,
+                 std::numeric_limits<double>::infinity());
+  visitor.number(prefix + "segment_max_incidence", &options->segment_max_incidence, 0.0, 0.5 * M_PI);
+  visitor.nonNegativeNumber(prefix + "isolated_footprint", &options->isolated_footprint);
+}
 
 /// The stamp of one reference point: the values of the cells (dx, dy) cells from its cell, |dx|, |dy| <=
 /// radius, row by row. Its largest value is the table's maxCellValue().

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -55,6 +56,31 @@ struct MbicpOptions {
   /// so a sparse far point cannot turn the scan by its beam spacing. <= 0: point-to-point as MbICP.
   double point_noise = 0.01;
 };
+
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, MbicpOptions* options) {
+  visitor.positiveNumber("mbicp/metric_l", &options->metric_l);
+  visitor.number("mbicp/bearing_window", &options->bearing_window, 0.0, M_PI, true);
+  visitor.positiveNumber("mbicp/max_distance", &options->max_distance);
+  visitor.nonNegativeNumber("mbicp/fine_max_distance", &options->fine_max_distance);
+  visitor.nonNegativeNumber("mbicp/settle_step_xy", &options->settle_step_xy);
+  visitor.nonNegativeNumber("mbicp/settle_step_theta", &options->settle_step_theta);
+  visitor.nonNegativeNumber("mbicp/segment_max_gap", &options->segment_max_gap);
+  visitor.number("mbicp/segment_max_incidence", &options->segment_max_incidence, 0.0, 0.5 * M_PI);
+  visitor.boolean("mbicp/point_to_line", &options->point_to_line);
+  visitor.nonNegativeNumber("mbicp/robust_scale", &options->robust_scale);
+  visitor.number("mbicp/trim_fraction", &options->trim_fraction, 0.0, 1.0, true);
+  visitor.nonNegativeNumber("mbicp/point_noise", &options->point_noise);
+  visitor.positiveInteger("mbicp/max_iterations", &options->max_iterations);
+  visitor.nonNegativeNumber("mbicp/error_ratio", &options->error_ratio);
+  visitor.nonNegativeNumber("mbicp/min_step_xy", &options->min_step_xy);
+  visitor.nonNegativeNumber("mbicp/min_step_theta", &options->min_step_theta);
+  visitor.positiveInteger("mbicp/converged_iterations", &options->converged_iterations);
+  visitor.fraction("mbicp/min_association_ratio", &options->min_association_ratio);
+  visitor.fraction("mbicp/degenerate_eigenvalue", &options->degenerate_eigenvalue);
+  visitor.nonNegativeNumber("mbicp/independent_points", &options->independent_points);
+}
 
 /// A Gaussian belief about the pose being estimated (the new scan in the reference frame), e.g. the
 /// motion predicted by wheel odometry: MbICP then finds the maximum a posteriori pose of scan and prior.

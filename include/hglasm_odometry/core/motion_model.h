@@ -30,6 +30,22 @@ struct MotionNoiseOptions {
   double constant_velocity_velocity_theta = 0.3;  ///< rad/s: error of the turn rate measured from the scans
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, MotionNoiseOptions* options) {
+  visitor.nonNegativeNumber("odometry/noise/xy_per_metre", &options->xy_per_metre);
+  visitor.nonNegativeNumber("odometry/noise/xy_per_radian", &options->xy_per_radian);
+  visitor.nonNegativeNumber("odometry/noise/xy_per_second", &options->xy_per_second);
+  visitor.nonNegativeNumber("odometry/noise/theta_per_metre", &options->theta_per_metre);
+  visitor.nonNegativeNumber("odometry/noise/theta_per_radian", &options->theta_per_radian);
+  visitor.nonNegativeNumber("odometry/noise/theta_per_second", &options->theta_per_second);
+  visitor.nonNegativeNumber("odometry/noise/systematic", &options->systematic);
+  visitor.positiveNumber("constant_velocity/xy", &options->constant_velocity_xy);
+  visitor.positiveNumber("constant_velocity/theta", &options->constant_velocity_theta);
+  visitor.nonNegativeNumber("constant_velocity/velocity_xy", &options->constant_velocity_velocity_xy);
+  visitor.nonNegativeNumber("constant_velocity/velocity_theta", &options->constant_velocity_velocity_theta);
+}
+
 /// What a predicted motion's noise is made of: the two variance scales of the wheels' model.
 struct MotionNoiseScale {
   double xy = 1.0;

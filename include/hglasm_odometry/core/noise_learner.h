@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <deque>
+#include <string>
 
 #include "hglasm_odometry/core/motion_model.h"
 #include "hglasm_odometry/core/pose2d.h"
@@ -26,6 +27,24 @@ struct NoiseLearnerOptions {
   double min_scan_scale = 0.01;  ///< bounds of the scan's learned variance scales
   double max_scan_scale = 1e4;
 };
+
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, NoiseLearnerOptions* options) {
+  visitor.boolean("odometry/noise/learn", &options->learn_wheels);
+  visitor.positiveNumber("odometry/noise/learn_half_life", &options->half_life);
+  visitor.positiveInteger("odometry/noise/learn_lags", &options->lags);
+  visitor.positiveNumber("odometry/noise/min_scale", &options->min_wheel_scale);
+  visitor.positiveNumber("odometry/noise/max_scale", &options->max_wheel_scale);
+  visitor.boolean("scan_noise/learn", &options->learn_scan);
+  visitor.boolean("scan_noise/directional", &options->directional);
+  visitor.positiveNumber("scan_noise/min_scale", &options->min_scan_scale);
+  visitor.positiveNumber("scan_noise/max_scale", &options->max_scan_scale);
+}
+
+/// Constraints between its parameters, checked once every layer is applied: "" if met, else one line
+/// naming the parameter after `prefix` ("~").
+std::string inconsistency(const NoiseLearnerOptions& options, const std::string& prefix);
 
 /// One matched scan as the learner sees it.
 struct NoiseSample {

@@ -35,6 +35,14 @@ struct UncertaintyOptions {
   double unexplained_theta = 0.0055;  ///< rad per sqrt(s)
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, UncertaintyOptions* options) {
+  visitor.number("fallback_covariance_scale", &options->fallback_scale, 1.0, 1e12);
+  visitor.nonNegativeNumber("covariance/unexplained_xy", &options->unexplained_xy);
+  visitor.nonNegativeNumber("covariance/unexplained_theta", &options->unexplained_theta);
+}
+
 struct TrackerOptions {
   MatcherOptions matcher;
   ScanConversionOptions conversion;  ///< applied by callers that convert RangeScans (ROS layer, tools)
@@ -60,6 +68,30 @@ struct TrackerOptions {
   /// stamp less far behind is dropped.
   double reset_on_jump_back = 3.0;
 };
+
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, TrackerOptions* options) {
+  visitOptions(visitor, &options->keyframe);
+  visitor.fraction("min_fitness", &options->min_fitness);
+  visitor.positiveInteger("min_points", &options->min_points);
+  visitor.positiveNumber("time/reset_on_jump_back", &options->reset_on_jump_back);
+  visitor.boolean("fusion", &options->fusion);
+  visitOptions(visitor, &options->uncertainty);
+  visitOptions(visitor, &options->search);
+  visitOptions(visitor, &options->leap);
+  visitOptions(visitor, &options->local_map);
+  visitOptions(visitor, &options->prediction);
+  visitOptions(visitor, &options->learning);
+  visitOptions(visitor, &options->motion);
+  visitOptions(visitor, &options->conversion);
+  visitor.boolean("scan/deskew", &options->deskew);
+  visitOptions(visitor, &options->matcher);
+}
+
+/// Constraints between its parameters, checked once every layer is applied: "" if met, else one line
+/// naming the parameter after `prefix` ("~").
+std::string inconsistency(const TrackerOptions& options, const std::string& prefix);
 
 /// How one scan was predicted, searched, matched and judged, and what is learned so far: for the node's
 /// Match message and diagnostics and for `evaluate --trace`.

@@ -48,6 +48,17 @@ struct PoseExtrapolatorOptions {
   GyroOptions imu;
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, PoseExtrapolatorOptions* options) {
+  visitor.boolean("use_odom", &options->use_odometry);
+  visitor.boolean("use_imu", &options->use_imu);
+  visitor.nonNegativeNumber("odometry/max_extrapolation", &options->max_odometry_extrapolation);
+  visitor.positiveNumber("odometry/max_speed", &options->max_speed);
+  visitor.positiveNumber("odometry/max_turn_rate", &options->max_turn_rate);
+  visitOptions(visitor, &options->imu);
+}
+
 /// Not thread-safe per instance.
 class PoseExtrapolator {
  public:

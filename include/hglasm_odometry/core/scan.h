@@ -40,6 +40,20 @@ struct ScanConversionOptions {
   double sweep_time = 0.0;
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, ScanConversionOptions* options) {
+  visitor.nonNegativeNumber("scan/min_range", &options->min_range);
+  visitor.number("scan/max_range", &options->max_range, 0.0, std::numeric_limits<double>::infinity(), true,
+                 true);
+  visitor.integer("scan/beam_step", &options->beam_step, 1, 100);
+  visitor.number("scan/sweep_time", &options->sweep_time, 0.0, kMaxSweepTime);
+}
+
+/// Constraints between its parameters, checked once every layer is applied: "" if met, else one line
+/// naming the parameter after `prefix` ("~").
+std::string inconsistency(const ScanConversionOptions& options, const std::string& prefix);
+
 /// Valid points of one scan in the sensor frame, in beam order.
 struct Scan {
   std::vector<Eigen::Vector2d> points;

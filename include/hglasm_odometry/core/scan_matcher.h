@@ -44,8 +44,17 @@ struct MatcherOptions {
   }();
 };
 
-/// Each preset: the defaults above with the search space of the papers' Table 1 (config/presets.yaml holds
-/// the same values for ROS users).
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, MatcherOptions* options) {
+  visitOptions(visitor, "table/", &options->table);
+  visitOptions(visitor, "coarse_table/", &options->coarse_table);
+  visitOptions(visitor, &options->genetic);
+  visitOptions(visitor, &options->mbicp);
+}
+
+/// Each preset: the defaults above with the search space of the papers' Table 1 (config/presets.yaml lists
+/// what each changes, for ROS users).
 MatcherOptions presetOptions(Preset preset);
 
 enum class MatchStatus {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 
 #include "hglasm_odometry/core/genetic_aligner.h"
 
@@ -17,6 +18,14 @@ struct SearchOptions {
   double min_xy = 0.10;     ///< metres
   double min_theta = 0.05;  ///< radians
 };
+
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, SearchOptions* options) {
+  visitor.positiveNumber("search/sigmas", &options->sigmas);
+  visitor.nonNegativeNumber("search/min_xy", &options->min_xy);
+  visitor.number("search/min_theta", &options->min_theta, 0.0, M_PI);
+}
 
 /// The search around a prediction of `covariance` (x, y, theta) with the `configured` preset's GA.
 SearchEffort searchAround(const GeneticOptions& configured, const SearchOptions& options,

@@ -29,6 +29,14 @@ struct SensorLearningOptions {
   TimeOffsetOptions odometry_time_offset;
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, SensorLearningOptions* options) {
+  visitOptions(visitor, &options->odometry_time_offset);
+  visitOptions(visitor, &options->noise);
+  visitOptions(visitor, &options->wheel_calibration);
+}
+
 /// Where a matched scan alone put the base.
 struct ScanOnlyPose {
   Pose2D pose;  ///< the base in the odometry frame

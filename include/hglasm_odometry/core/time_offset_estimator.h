@@ -29,6 +29,18 @@ struct TimeOffsetOptions {
   double max_offset = 1.0;  ///< seconds: the candidates span [-max_offset, max_offset]
 };
 
+/// Seconds: the largest offset that may be set by hand (a larger one is a misconfigured clock).
+constexpr double kMaxFixedTimeOffset = 10.0;
+
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, TimeOffsetOptions* options) {
+  bool automatic = options->estimate;
+  visitor.autoOrNumber("odometry/time_offset", &automatic, &options->offset, kMaxFixedTimeOffset, "seconds");
+  options->estimate = automatic;
+  visitor.number("odometry/max_time_offset", &options->max_offset, 0.0, kMaxFixedTimeOffset);
+}
+
 /// Not thread-safe per instance.
 class TimeOffsetEstimator {
  public:

@@ -20,6 +20,16 @@ struct WheelCalibrationOptions {
   double distance_scale = 0.05;     ///< fraction of the distance
 };
 
+/// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, WheelCalibrationOptions* options) {
+  visitor.boolean("odometry/calibration/learn", &options->learn);
+  visitor.positiveNumber("odometry/calibration/half_life", &options->half_life);
+  visitor.positiveNumber("odometry/calibration/heading_per_metre", &options->heading_per_metre);
+  visitor.positiveNumber("odometry/calibration/turn_scale", &options->turn_scale);
+  visitor.positiveNumber("odometry/calibration/distance_scale", &options->distance_scale);
+}
+
 /// Recursive least squares on the steps between consecutive matched scans: the heading the scans saw turned
 /// against the wheels' (turn_scale * turn + heading_per_metre * distance), and the distance along the
 /// wheels' direction against theirs (distance_scale * distance). Not thread-safe per instance.

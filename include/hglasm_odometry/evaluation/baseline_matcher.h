@@ -43,12 +43,13 @@ TableKernel binaryKernel(const LookupTableOptions& options);
 
 struct BaselineOptions {
   Algorithm algorithm = Algorithm::kHglasmG;
-  MatcherOptions matcher;   ///< the tables (binary for the binary algorithms), the GA, MbICP
-  PolarPairingOptions pga;  ///< PGA / HPGA only
+  MatcherOptions matcher;  ///< the tables (binary for the binary algorithms), the GA, MbICP
 };
-/// A preset's options for `algorithm`: PGA pairs within the reach of GLASM's tables (the fine table's
-/// cut-off, then the coarse one's).
+/// A preset's options for `algorithm`.
 BaselineOptions baselineOptions(Algorithm algorithm, Preset preset);
+/// PGA's (and HPGA's) pairing: within the reach of GLASM's tables (the fine table's cut-off, then the coarse
+/// one's). Derived when the matcher is built, so an override of a table's cut-off reaches it.
+PolarPairingOptions polarPairingOptions(const MatcherOptions& matcher);
 
 /// One algorithm on one reference at a time (setReference() prepares what it needs: lookup tables, the
 /// coarse one on first use, PGA's angular sort, MbICP's structure). Not thread-safe per instance.
@@ -68,6 +69,8 @@ class BaselineMatcher {
   double lastCoarseTableBuildMs() const { return coarse_table_build_ms_; }
   /// The GA's fine lookup table (empty for MbICP, PGA and HPGA).
   const LookupTable& table() const { return table_; }
+  /// PGA's angular sort (empty for the other algorithms).
+  const PolarPairing& polarPairing() const { return polar_pairing_; }
   Algorithm algorithm() const { return options_.algorithm; }
   const BaselineOptions& options() const { return options_; }
   void reseed(std::uint64_t seed) { aligner_.reseed(seed); }

@@ -26,6 +26,16 @@ struct DiagnosticsOptions {
   double period = 1.0;               ///< seconds between /diagnostics messages (wall clock)
 };
 
+/// Its parameters with their valid ranges, for OptionReader and OptionWriter (core/parameter_source.h).
+template <typename Visitor>
+void visitOptions(Visitor& visitor, DiagnosticsOptions* options) {
+  visitor.nonNegativeNumber("diagnostics/min_rate", &options->min_rate);
+  visitor.fraction("diagnostics/warn_failure_ratio", &options->warn_failure_ratio);
+  visitor.fraction("diagnostics/error_failure_ratio", &options->error_failure_ratio);
+  visitor.positiveNumber("diagnostics/window", &options->window);
+  visitor.positiveNumber("diagnostics/period", &options->period);
+}
+
 /// One scan processed (not a stale one), for the window of statistics.
 struct ScanRecord {
   double time = 0.0;  ///< when it was done (seconds, the clock `now` is on)

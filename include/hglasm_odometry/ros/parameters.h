@@ -1,4 +1,6 @@
-// Every parameter of the laser odometry, read and validated in one place into a typed struct.
+// Every parameter of the laser odometry, read and validated into a typed struct. The core modules declare
+// their own parameters beside their options (visitOptions, core/parameter_source.h); this layer adds the
+// node's (frames, topics, queue, diagnostics), composes them and applies the layers below.
 //
 // Order of precedence (later wins):
 //   1. the built-in values of the preset named by ~preset (hglasm::presetOptions, small|medium|large);
@@ -21,6 +23,7 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include "hglasm_odometry/core/odometry_tracker.h"
+#include "hglasm_odometry/core/parameter_source.h"
 #include "hglasm_odometry/ros/diagnostics.h"  // DiagnosticsOptions
 
 namespace hglasm_odometry {
@@ -32,6 +35,17 @@ struct SetPoseOptions {
   /// Relative names resolve in the private namespace (~set_pose); "/initialpose" takes rviz's estimates.
   std::string topic = "set_pose";
 };
+
+/// A frame id: a leading slash is dropped (tf2 rejects it). Never fails (an empty frame fails later).
+std::string normalizeFrame(std::string* frame);
+/// "" for a valid relative or absolute graph resource name (not a private "~" one), else what it must be.
+std::string checkTopic(std::string* topic);
+
+template <typename Visitor>
+void visitOptions(Visitor& visitor, SetPoseOptions* options) {
+  visitor.boolean("set_pose/topic_enabled", &options->topic_enabled);
+  visitor.text("set_pose/topic", &options->topic, checkTopic);
+}
 
 struct LaserOdometryOptions {
   std::string preset = "medium";  ///< name of the preset the matcher options started from
@@ -52,9 +66,42 @@ struct LaserOdometryOptions {
   DiagnosticsOptions diagnostics;
 };
 
-/// Loads options from the private namespace as one XmlRpc struct (as returned by getParam on the
-/// namespace). Needs no ROS master, which is what the unit tests use. On failure returns false,
-/// sets *error to one line naming the parameter, and leaves *options unspecified.
+/// Every option except ~preset itself (which selects the starting point), each at its parameter path with
+/// its valid range: read from the ~presets/<name> subtree and from the top level alike, or written.
+template <typename Visitor>
+void visitOptions(Visitor& visitor, LaserOdometryOptions* options) {
+  visitor.text("odom_frame", &options->odom_frame, normalizeFrame);
+  visitor.text("base_frame", &options->base_frame, normalizeFrame);
+  visitor.boolean("publish_tf", &options->publish_tf);
+  visitor.integer("path_length", &options->path_length, 0, 1000000);
+  visitor.integer("queue_size", &options->queue_size, 1, 10000);
+  visitor.boolean("publish_population", &options->publish_population);
+  visitor.positiveNumber("tf_warn_period", &options->tf_warn_period);
+  visitor.number("odometry/wait", &options->odometry_wait, 0.0, 10.0);
+  visitOptions(visitor, &options->set_pose);
+  hglasm::visitOptions(visitor, &options->tracker);
+  visitOptions(visitor, &options->diagnostics);
+}
+
+/// The parameter server's values (an XmlRpc struct, as getParam returns a namespace) as a ParameterSource.
+class XmlRpcParameterSource : public hglasm::ParameterSource {
+ public:
+  explicit XmlRpcParameterSource(const XmlRpc::XmlRpcValue& root) : root_(root) {}
+  bool find(const std::string& path, hglasm::ParameterValue* value) const override;
+  std::vector<std::string> leafPaths() const override;
+
+ private:
+  const XmlRpc::XmlRpcValue& root_;
+};
+
+/// Loads options from the private namespace's parameters, in the order of precedence above: the one loader
+/// of the nodelet, the node and the offline tools (a YAML file). On failure returns false, sets *error to
+/// one line naming the parameter, and leaves *options unspecified.
+bool loadOptions(const hglasm::ParameterSource& private_params, LaserOdometryOptions* options,
+                 std::string* error, std::vector<std::string>* warnings = nullptr);
+
+/// The same from one XmlRpc struct (as returned by getParam on the namespace). Needs no ROS master, which
+/// is what the unit tests use.
 bool loadOptions(const XmlRpc::XmlRpcValue& private_params, LaserOdometryOptions* options, std::string* error,
                  std::vector<std::string>* warnings = nullptr);
 
@@ -65,6 +112,8 @@ bool loadOptions(const ros::NodeHandle& private_nh, LaserOdometryOptions* option
 /// Every option at the parameter path loadOptions reads it from (~preset and ~presets aside): loading the
 /// result gives `options` back. For comparing a configuration with the shipped YAML, or printing it.
 XmlRpc::XmlRpcValue toParams(const LaserOdometryOptions& options);
+/// The same as a ParameterTree.
+hglasm::ParameterTree toParameterTree(const LaserOdometryOptions& options);
 
 /// One line for the log: preset, box, GA size, frames.
 std::string summarize(const LaserOdometryOptions& options);

@@ -1,6 +1,6 @@
-// Parameter YAML files read into the XmlRpc tree the parameter server would hold after rosparam (and
-// roslaunch's <rosparam command="load">) loaded them, without Python or a master, so that the offline
-// tools and the nodelet share one loader (hglasm_odometry::loadOptions).
+// Parameter YAML files read into a ParameterTree holding what the parameter server would hold after
+// rosparam (and roslaunch's <rosparam command="load">) loaded them, without Python or a master, so that the
+// offline tools and the nodelet share one loader (hglasm_odometry::loadOptions over a ParameterSource).
 //
 // yaml-cpp parses; plain scalars are typed as rosparam types them for the forms a parameter file needs:
 // YAML 1.1 bools (true/false, yes/no, on/off), decimal ints (32-bit), floats with a dot (1.0e-4, .5, 3.),
@@ -12,12 +12,12 @@
 
 #include <string>
 
-#include <xmlrpcpp/XmlRpcValue.h>
+#include "hglasm_odometry/core/parameter_source.h"
 
 namespace hglasm_odometry {
 
-/// Reads a parameter file whose top level is a mapping (or empty) into *value (a struct); rosparam's
-/// namespace key `_ns` at the top level is dropped, as rosparam.load_file does. False with *error set.
-bool loadYamlParameters(const std::string& path, XmlRpc::XmlRpcValue* value, std::string* error);
+/// Reads a parameter file whose top level is a mapping (or empty) into *tree; rosparam's namespace key
+/// `_ns` at the top level is dropped, as rosparam.load_file does. False with *error set.
+bool loadYamlParameters(const std::string& path, hglasm::ParameterTree* tree, std::string* error);
 
 }  // namespace hglasm_odometry
