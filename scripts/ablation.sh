@@ -30,7 +30,8 @@ shift $((OPTIND - 1))
 variants=("$@")
 if ((${#variants[@]} == 0)); then
   variants=(default: scan:scan_noise/learn=true "scan_one:scan_noise/learn=true,scan_noise/directional=false"
-            nothing_learned:odometry/noise/learn=false calibration:odometry/calibration/learn=true
+            nothing_learned:odometry/noise/learn=false no_calibration:odometry/calibration/learn=false
+            "calibration_all:odometry/calibration/heading_per_metre=0.02,odometry/calibration/distance_scale=0.05"
             keyframes_7:local_map/keyframes=7)
 fi
 [[ -x "$evaluate" ]] || { echo "ablation: evaluate not found; build it or pass -e" >&2; exit 2; }

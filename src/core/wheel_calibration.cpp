@@ -11,6 +11,9 @@ constexpr double kOutlierSigmas = 4.0;
 
 double square(double value) { return value * value; }
 
+/// The prior information of an error whose standard deviation is `sigma` (0: known to be none).
+double priorInformation(double sigma) { return 1.0 / square(std::max(sigma, 1e-9)); }
+
 }  // namespace
 
 WheelCalibration::WheelCalibration(const WheelCalibrationOptions& options) : options_(options) { reset(); }
@@ -18,11 +21,11 @@ WheelCalibration::WheelCalibration(const WheelCalibrationOptions& options) : opt
 void WheelCalibration::reset() {
   heading_.setZero();
   heading_vector_.setZero();
-  heading_information_ = Eigen::Vector2d(1.0 / square(std::max(options_.turn_scale, 1e-9)),
-                                         1.0 / square(std::max(options_.heading_per_metre, 1e-9)))
-                             .asDiagonal();
+  heading_information_ =
+      Eigen::Vector2d(priorInformation(options_.turn_scale), priorInformation(options_.heading_per_metre))
+          .asDiagonal();
   distance_ = distance_vector_ = 0.0;
-  distance_information_ = 1.0 / square(std::max(options_.distance_scale, 1e-9));
+  distance_information_ = priorInformation(options_.distance_scale);
 }
 
 Pose2D WheelCalibration::correct(const Pose2D& wheel_motion) const {
@@ -41,9 +44,9 @@ void WheelCalibration::learn(const Pose2D& wheel_motion, const Pose2D& scan_moti
   if (!options_.learn || !wheel_motion.isFinite() || !scan_motion.isFinite()) return;
   // Forgetting pulls the information back towards the prior's, so the estimates follow slow changes.
   const double forget = std::exp2(-1.0 / std::max(1.0, options_.half_life));
-  const Eigen::Matrix2d prior = Eigen::Vector2d(1.0 / square(std::max(options_.turn_scale, 1e-9)),
-                                                1.0 / square(std::max(options_.heading_per_metre, 1e-9)))
-                                    .asDiagonal();
+  const Eigen::Matrix2d prior =
+      Eigen::Vector2d(priorInformation(options_.turn_scale), priorInformation(options_.heading_per_metre))
+          .asDiagonal();
   const double distance = wheel_motion.translationNorm();
   const Eigen::Vector2d regressors(wheel_motion.theta, distance);
   const double heading_residual = normalizeAngle(scan_motion.theta - wheel_motion.theta);
@@ -54,12 +57,12 @@ void WheelCalibration::learn(const Pose2D& wheel_motion, const Pose2D& scan_moti
     heading_vector_ = forget * heading_vector_ + regressors * heading_residual / heading_variance;
     heading_ = heading_information_.lu().solve(heading_vector_);
   }
-  if (distance > 1e-3 && distance_variance > 0.0) {
+  if (options_.distance_scale > 0.0 && distance > 1e-3 && distance_variance > 0.0) {
     // The scans' distance along the wheels' direction of travel.
     const double along = (scan_motion.x * wheel_motion.x + scan_motion.y * wheel_motion.y) / distance;
     const double residual = along - distance;
     if (square(residual - distance_ * distance) <= square(kOutlierSigmas) * distance_variance) {
-      const double prior_distance = 1.0 / square(std::max(options_.distance_scale, 1e-9));
+      const double prior_distance = priorInformation(options_.distance_scale);
       distance_information_ = forget * distance_information_ + (1.0 - forget) * prior_distance +
                               distance * distance / distance_variance;
       distance_vector_ = forget * distance_vector_ + distance * residual / distance_variance;

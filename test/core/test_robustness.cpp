@@ -795,25 +795,39 @@ Path miscalibratedCircle(double factor) {
   };
 }
 
+/// Drives the circle with wheels that over-report turning by `factor`; the estimate must follow the scans.
+hglasm::LearnedModels learnedOnTheCircle(double factor, bool calibrate) {
+  TrackerOptions options;
+  options.learning.wheel_calibration.learn = calibrate;
+  Robot robot(options, circlePath);
+  robot.enableOdometry();
+  robot.setOdometryPath(miscalibratedCircle(factor));
+  TrackerUpdate update;
+  for (int i = 0; i <= 300; ++i) {
+    update = robot.step(0.1 * i);
+    expectPoseNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
+  }
+  return update.diagnostics.learned;
+}
+
 TEST(Fusion, TheWheelsNoiseIsLearnedFromTheScans) {
-  // Exact wheels teach a small heading-noise scale; wheels that over-report turning by half a large one,
-  // and the estimate follows the scans either way.
-  const auto drive = [](double factor) {
-    Robot robot(TrackerOptions(), circlePath);
-    robot.enableOdometry();
-    robot.setOdometryPath(miscalibratedCircle(factor));
-    TrackerUpdate update;
-    for (int i = 0; i <= 300; ++i) {
-      update = robot.step(0.1 * i);
-      expectPoseNear(update.pose, robot.truth(0.1 * i), 0.03, deg(0.5), describe(update));
-    }
-    return update.diagnostics.learned.wheel_noise;
-  };
-  const hglasm::MotionNoiseScale exact = drive(1.0);
-  const hglasm::MotionNoiseScale bad = drive(1.5);
+  // Without the turn calibration, exact wheels teach a small heading-noise scale and wheels that over-report
+  // turning by half a large one.
+  const hglasm::MotionNoiseScale exact = learnedOnTheCircle(1.0, false).wheel_noise;
+  const hglasm::MotionNoiseScale bad = learnedOnTheCircle(1.5, false).wheel_noise;
   EXPECT_LT(exact.theta, 0.1);
   EXPECT_GT(bad.theta, 1.0);
   EXPECT_GT(bad.theta, 20.0 * exact.theta);
+}
+
+TEST(Fusion, AWrongWheelBaseIsCalibratedAwayNotLearnedAsNoise) {
+  // By default the turn scale is learned: wheels over-reporting turns by half (true = wheels * (1 - 1/3))
+  // are corrected, and what is left of their heading noise is as small as exact wheels'.
+  const hglasm::LearnedModels exact = learnedOnTheCircle(1.0, true);
+  const hglasm::LearnedModels bad = learnedOnTheCircle(1.5, true);
+  EXPECT_NEAR(exact.wheel_turn_scale, 0.0, 0.01);
+  EXPECT_NEAR(bad.wheel_turn_scale, 1.0 / 1.5 - 1.0, 0.02);
+  EXPECT_LT(bad.wheel_noise.theta, 0.1);
 }
 
 }  // namespace

@@ -12,13 +12,21 @@ using hglasm::Pose2D;
 using hglasm::WheelCalibration;
 using hglasm::WheelCalibrationOptions;
 
+/// Learning all three errors, each with a prior of how miscalibrated wheels may be.
+WheelCalibrationOptions allThree() {
+  WheelCalibrationOptions options;
+  options.learn = true;
+  options.turn_scale = 0.1;
+  options.heading_per_metre = 0.02;
+  options.distance_scale = 0.05;
+  return options;
+}
+
 /// Wheels that count turns `turn_scale` short (true turn = wheels' * (1 + turn_scale)), drift by
 /// `heading_per_metre`, and count distances `distance_scale` short; the scans see the true motion with
 /// noise. Returns the learned calibration.
 WheelCalibration learnFrom(double turn_scale, double heading_per_metre, double distance_scale, int steps,
-                           std::uint64_t seed) {
-  WheelCalibrationOptions options;
-  options.learn = true;
+                           std::uint64_t seed, WheelCalibrationOptions options = allThree()) {
   WheelCalibration calibration(options);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal;
@@ -65,13 +73,26 @@ TEST(WheelCalibration, CalibratedWheelsLearnNothingAndNothingIsCorrected) {
   EXPECT_EQ(same.theta, step.theta);
 }
 
+TEST(WheelCalibration, TheDefaultLearnsTheTurnScaleAlone) {
+  // Wheels with all three errors: the default takes the drift per metre and the distance scale as none (the
+  // scans confound them with their own slow errors) and learns the turn scale, which every turn shows.
+  const WheelCalibration calibration = learnFrom(0.05, 0.01, 0.03, 5000, 4, WheelCalibrationOptions());
+  EXPECT_NEAR(calibration.headingPerMetre(), 0.0, 1e-9);
+  EXPECT_EQ(calibration.distanceScale(), 0.0);
+  EXPECT_NEAR(calibration.turnScale(), 0.05, 0.01);
+  const Pose2D corrected = calibration.correct(Pose2D(1.0, 0.0, 0.4 / 1.05));
+  EXPECT_NEAR(corrected.theta, 0.4, 0.004);
+  EXPECT_NEAR(corrected.translationNorm(), 1.0, 1e-12) << "the distance is the wheels'";
+}
+
 TEST(WheelCalibration, AStepItCannotExplainIsLeftOutAndLearningCanBeOff) {
   WheelCalibration calibration = learnFrom(0.0, 0.0, 0.0, 2000, 3);
   const double before = calibration.turnScale();
   // A slip: the scans saw a quarter turn the wheels did not count.
   calibration.learn(Pose2D(0.2, 0.0, 0.1), Pose2D(0.2, 0.0, 0.1 + M_PI / 2), 1e-6, 1e-4);
   EXPECT_EQ(calibration.turnScale(), before);
-  WheelCalibrationOptions off;  // learn is false by default
+  WheelCalibrationOptions off = allThree();
+  off.learn = false;
   WheelCalibration fixed(off);
   for (int i = 0; i < 100; ++i) fixed.learn(Pose2D(0.2, 0.0, 0.1), Pose2D(0.25, 0.0, 0.2), 1e-6, 1e-4);
   EXPECT_EQ(fixed.turnScale(), 0.0);

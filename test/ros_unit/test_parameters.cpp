@@ -204,8 +204,9 @@ TEST(Parameters, FusionLocalMapAndNoiseParametersAreRead) {
                                   {"odometry/noise/learn", false},
                                   {"odometry/noise/learn_lags", 3},
                                   {"odometry/noise/systematic", 0.02},
-                                  {"odometry/calibration/learn", true},
+                                  {"odometry/calibration/learn", false},
                                   {"odometry/calibration/turn_scale", 0.2},
+                                  {"odometry/calibration/heading_per_metre", 0.01},
                                   {"scan_noise/learn", true},
                                   {"scan_noise/directional", false},
                                   {"scan_noise/min_scale", 0.5},
@@ -223,8 +224,9 @@ TEST(Parameters, FusionLocalMapAndNoiseParametersAreRead) {
   EXPECT_FALSE(t.learning.noise.learn_wheels);
   EXPECT_EQ(t.learning.noise.lags, 3);
   EXPECT_EQ(t.motion.systematic, 0.02);
-  EXPECT_TRUE(t.learning.wheel_calibration.learn);
+  EXPECT_FALSE(t.learning.wheel_calibration.learn);
   EXPECT_EQ(t.learning.wheel_calibration.turn_scale, 0.2);
+  EXPECT_EQ(t.learning.wheel_calibration.heading_per_metre, 0.01);
   EXPECT_TRUE(t.learning.noise.learn_scan);
   EXPECT_FALSE(t.learning.noise.directional);
   EXPECT_EQ(t.learning.noise.min_scan_scale, 0.5);

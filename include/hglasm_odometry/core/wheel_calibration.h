@@ -1,6 +1,9 @@
-// The wheels' systematic errors, learned from the scans: a heading drift per metre travelled (wheels of
-// slightly different size), a turn-rate scale (a wrong wheel base) and a distance scale (a wrong wheel
+// The wheels' systematic errors, learned from the scans: a turn-rate scale (a wrong wheel base), a heading
+// drift per metre travelled (wheels of slightly different size) and a distance scale (a wrong wheel
 // radius). Noise averages out over a log; these add up, and are what makes even good-looking wheels drift.
+// By default only the turn scale is learned: the scans see rotation well in every turn, while a drift per
+// metre is confounded with their own slow heading error and a distance scale with their bias along
+// corridors (doc/accuracy.md, "Ablation").
 #pragma once
 
 #include <Eigen/Core>
@@ -10,14 +13,13 @@
 namespace hglasm {
 
 struct WheelCalibrationOptions {
-  /// Off by default: on the Freiburg logs the scans' own slow heading errors teach drifts the wheels do
-  /// not have (README "Learning both noises").
-  bool learn = false;
+  bool learn = true;
   double half_life = 2000.0;  ///< matched scans after which an old step counts half (temperature, load)
-  /// Standard deviations of the errors before anything is learned (how miscalibrated wheels may be).
-  double heading_per_metre = 0.02;  ///< rad/m
-  double turn_scale = 0.1;          ///< fraction of the turn
-  double distance_scale = 0.05;     ///< fraction of the distance
+  /// Standard deviations of the errors before anything is learned (how miscalibrated wheels may be); 0: that
+  /// error is taken as none and not learned.
+  double turn_scale = 0.1;         ///< fraction of the turn
+  double heading_per_metre = 0.0;  ///< rad/m
+  double distance_scale = 0.0;     ///< fraction of the distance
 };
 
 /// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
@@ -25,9 +27,9 @@ template <typename Visitor>
 void visitOptions(Visitor& visitor, WheelCalibrationOptions* options) {
   visitor.boolean("odometry/calibration/learn", &options->learn);
   visitor.positiveNumber("odometry/calibration/half_life", &options->half_life);
-  visitor.positiveNumber("odometry/calibration/heading_per_metre", &options->heading_per_metre);
-  visitor.positiveNumber("odometry/calibration/turn_scale", &options->turn_scale);
-  visitor.positiveNumber("odometry/calibration/distance_scale", &options->distance_scale);
+  visitor.nonNegativeNumber("odometry/calibration/turn_scale", &options->turn_scale);
+  visitor.nonNegativeNumber("odometry/calibration/heading_per_metre", &options->heading_per_metre);
+  visitor.nonNegativeNumber("odometry/calibration/distance_scale", &options->distance_scale);
 }
 
 /// Recursive least squares on the steps between consecutive matched scans: the heading the scans saw turned
