@@ -1,12 +1,12 @@
 #include "hglasm_odometry/core/odometry_tracker.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <functional>
 #include <sstream>
 
 #include "hglasm_odometry/core/deskew.h"
+#include "hglasm_odometry/core/timing.h"
 
 namespace hglasm {
 
@@ -23,10 +23,6 @@ namespace {
 bool matchUsable(const MatchResult& match) {
   return (match.status == MatchStatus::kOk || match.status == MatchStatus::kMbicpNotConverged) &&
          match.pose.isFinite();
-}
-
-double millisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace

@@ -1,16 +1,10 @@
 #include "hglasm_odometry/core/scan_matcher.h"
 
-#include <chrono>
 #include <cmath>
 
+#include "hglasm_odometry/core/timing.h"
+
 namespace hglasm {
-namespace {
-
-double millisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 const char* toString(Preset preset) {
   switch (preset) {

@@ -1,14 +1,11 @@
 #include "hglasm_odometry/evaluation/baseline_matcher.h"
 
-#include <chrono>
 #include <cmath>
+
+#include "hglasm_odometry/core/timing.h"
 
 namespace hglasm {
 namespace {
-
-double millisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 TableKernelFunction kernelOf(Algorithm algorithm) {
   return usesBinaryTables(algorithm) ? binaryKernel : gradedKernel;

@@ -7,7 +7,7 @@
 
 #include <geometry_msgs/TransformStamped.h>
 
-#include "hglasm_odometry/core/cpu_time.h"
+#include "hglasm_odometry/core/timing.h"
 
 namespace hglasm_odometry {
 namespace {
@@ -15,10 +15,6 @@ namespace {
 /// Seconds on the clock of the throttling, the mounts' retries and the diagnostics (monotonic).
 double steadySeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-double msSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 /// Subscriber queues only need to absorb bursts until the callback moves the message into the bounded
@@ -375,7 +371,7 @@ void LaserOdometry::processScan(const sensor_msgs::LaserScan& msg) {
   const hglasm::PipelineUpdate result =
       pipeline_.processScan(msg.header.stamp.toSec(), ranges_, with_population ? &population_ : nullptr);
   reportScan(result);
-  publish(msg.header, result, with_population, msSince(start));
+  publish(msg.header, result, with_population, hglasm::millisecondsSince(start));
   recordScan(result.tracker, hglasm::threadCpuMs() - cpu_start);
 }
 

@@ -4,7 +4,7 @@
 #include <deque>
 #include <limits>
 
-#include "hglasm_odometry/core/cpu_time.h"
+#include "hglasm_odometry/core/timing.h"
 
 namespace hglasm_odometry {
 namespace {

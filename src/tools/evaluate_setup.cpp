@@ -8,7 +8,7 @@
 
 #include <ros/package.h>
 
-#include "hglasm_odometry/core/cpu_time.h"
+#include "hglasm_odometry/core/timing.h"
 #include "hglasm_odometry/tools/yaml_parameters.h"
 
 namespace hglasm_odometry {

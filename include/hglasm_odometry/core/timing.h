@@ -1,8 +1,10 @@
-// CPU time in milliseconds: what one scan costs, whatever other threads do (the one copy of these clocks).
+// Timings in milliseconds, the one copy of these clocks: CPU time (what one scan costs, whatever other
+// threads do) and wall time since a start (the per-stage timers).
 #pragma once
 
 #include <time.h>
 
+#include <chrono>
 #include <ctime>
 
 namespace hglasm {
@@ -20,5 +22,10 @@ inline double threadCpuMs() {
 
 /// CPU time of the whole process (bag decompression may run on other threads).
 inline double processCpuMs() { return 1e3 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+
+/// Wall milliseconds on the monotonic clock since `start`.
+inline double millisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
 
 }  // namespace hglasm
