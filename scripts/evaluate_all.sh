@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Runs `evaluate` on the Freiburg relations benchmark logs (intel, fr079, aces, fr-clinic) for every preset
 # and prints one table: relations metric (all and <= 10 s, and the <= 10 s median translation) of the laser
-# odometry next to the raw wheel odometry, the wheels' time offset found (odometry/time_offset),
-# fallbacks, CPU per scan, the covariance calibration (mean squared Mahalanobis distance of the <= 10 s
-# relations; 3 is honest), the along-track scale of the <= 10 s relations (laser/wheels: the distance
-# travelled along the reference's direction over the reference's; 1 is unbiased) and the leap ratio (largest
-# <= 10 s error / (3 x the wheels' + 0.10 m); above 1 is a leap). Logs, trajectories, traces and plots of
-# each run go to the output directory.
+# odometry next to the raw wheel odometry, the wheels' time offset found (odometry/time_offset), fallbacks,
+# CPU per scan, the covariance calibration (mean squared Mahalanobis distance of the <= 10 s relations; 3 is
+# honest), the along-track scale of the <= 10 s relations (laser/wheels: the distance travelled along the
+# reference's direction over the reference's; 1 is unbiased), the leap ratio (largest <= 10 s error /
+# (3 x the wheels' + 0.10 m); above 1 is a leap) and the timing of laser and wheels against the reference
+# (ms: heading error = timing x change of turn rate; 0 is the reference's clock). Logs, trajectories,
+# traces and plots of each run go to the output directory.
 #
 # usage: scripts/evaluate_all.sh [-e EVALUATE] [-d DATASETS] [-o OUT_DIR] [-p "small medium large"]
 #                                [-l "intel fr079"] [-- extra evaluate arguments]
@@ -33,8 +34,8 @@ while getopts "e:d:o:p:l:h" option; do
     o) out_dir="$OPTARG" ;;
     p) presets="$OPTARG" ;;
     l) logs="$OPTARG" ;;
-    h) sed -n '2,18p' "$0"; exit 0 ;;
-    *) sed -n '2,18p' "$0" >&2; exit 2 ;;
+    h) sed -n '2,20p' "$0"; exit 0 ;;
+    *) sed -n '2,20p' "$0" >&2; exit 2 ;;
   esac
 done
 shift $((OPTIND - 1))
@@ -72,9 +73,9 @@ echo "runs:     $out_dir/<log>_<preset>.{log,txt,png}"
 [[ ${#extra_args[@]} -gt 0 ]] && echo "extra:    ${extra_args[*]}"
 echo
 
-header=$(printf "%-9s %-6s %5s %8s %19s | %-17s %-17s %-13s %-13s | %-17s %-17s | %5s %5s %6s" \
+header=$(printf "%-9s %-6s %5s %8s %19s | %-17s %-17s %-13s %-13s | %-17s %-17s | %5s %5s %6s %11s" \
   log preset scans fallback "CPU ms med/p99/max" "<=10s laser m/deg" "<=10s wheel" "median l/w m" \
-  "scale l/w" "all laser m/deg" "all wheel" calib leap offset)
+  "scale l/w" "all laser m/deg" "all wheel" calib leap offset "timing l/w")
 echo "$header"
 printf '%*s\n' "${#header}" '' | tr ' ' '-'
 
@@ -97,12 +98,13 @@ for log in $logs; do
     fi
     summary="$(grep '^SUMMARY' "$run.log" | tail -n1)"
     field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$summary"; }
-    printf "%-9s %-6s %5s %7s%% %19s | %-17s %-17s %-13s %-13s | %-17s %-17s | %5s %5s %6s\n" "$log" "$preset" \
+    printf "%-9s %-6s %5s %7s%% %19s | %-17s %-17s %-13s %-13s | %-17s %-17s | %5s %5s %6s %11s\n" "$log" "$preset" \
       "$(field scans)" "$(field fallback_pct)" "$(field cpu_median_ms)/$(field cpu_p99_ms)/$(field cpu_max_ms)" \
       "$(field short_t) / $(field short_r)" "$(field wheel_short_t) / $(field wheel_short_r)" \
       "$(field short_t_median)/$(field wheel_short_t_median)" "$(field short_scale)/$(field wheel_short_scale)" \
       "$(field all_t) / $(field all_r)" "$(field wheel_all_t) / $(field wheel_all_r)" \
-      "$(printf %.2f "$(field calibration)")" "$(printf %.2f "$(field worst_leap)")" "$(field time_offset)"
+      "$(printf %.2f "$(field calibration)")" "$(printf %.2f "$(field worst_leap)")" "$(field time_offset)" \
+      "$(field timing_ms)/$(field wheel_timing_ms)"
   done
 done
 exit $status

@@ -36,6 +36,19 @@ long findStamp(const std::vector<StampedPose>& trajectory, double stamp, double 
   return best;
 }
 
+/// The heading of `trajectory` (sorted by stamp) at `stamp`, interpolated between the samples around it.
+bool headingAt(const std::vector<StampedPose>& trajectory, double stamp, double* heading) {
+  const auto after =
+      std::lower_bound(trajectory.begin(), trajectory.end(), stamp,
+                       [](const StampedPose& pose, double value) { return pose.stamp < value; });
+  if (after == trajectory.begin() || after == trajectory.end()) return false;
+  const StampedPose& a = *std::prev(after);
+  const StampedPose& b = *after;
+  const double fraction = b.stamp > a.stamp ? (stamp - a.stamp) / (b.stamp - a.stamp) : 0.0;
+  *heading = a.pose.theta + fraction * normalizeAngle(b.pose.theta - a.pose.theta);
+  return true;
+}
+
 }  // namespace
 
 bool readRelations(const std::string& path, std::vector<Relation>* relations, std::string* error) {
@@ -73,15 +86,9 @@ bool readRelations(const std::string& path, std::vector<Relation>* relations, st
 RelationStats evaluateRelations(const std::vector<Relation>& relations,
                                 const std::vector<StampedPose>& trajectory, double max_span,
                                 double stamp_tolerance) {
-  std::vector<Pose2D> estimated(relations.size());
-  std::vector<bool> valid(relations.size(), false);
-  for (std::size_t k = 0; k < relations.size(); ++k) {
-    const long i1 = findStamp(trajectory, relations[k].t1, stamp_tolerance);
-    const long i2 = findStamp(trajectory, relations[k].t2, stamp_tolerance);
-    if (i1 < 0 || i2 < 0) continue;
-    estimated[k] = relativePose(trajectory[i1].pose, trajectory[i2].pose);
-    valid[k] = true;
-  }
+  std::vector<Pose2D> estimated;
+  std::vector<bool> valid;
+  relativeMotions(relations, trajectory, &estimated, &valid, stamp_tolerance);
   return evaluateRelativeMotions(relations, estimated, valid, max_span);
 }
 
@@ -130,6 +137,59 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
   stats.trans_median = median(trans_errors);
   stats.rot_median_deg = median(rot_errors_deg);
   return stats;
+}
+
+void relativeMotions(const std::vector<Relation>& relations, const std::vector<StampedPose>& trajectory,
+                     std::vector<Pose2D>* estimated, std::vector<bool>* valid, double stamp_tolerance) {
+  estimated->assign(relations.size(), Pose2D());
+  valid->assign(relations.size(), false);
+  for (std::size_t k = 0; k < relations.size(); ++k) {
+    const long i1 = findStamp(trajectory, relations[k].t1, stamp_tolerance);
+    const long i2 = findStamp(trajectory, relations[k].t2, stamp_tolerance);
+    if (i1 < 0 || i2 < 0) continue;
+    (*estimated)[k] = relativePose(trajectory[i1].pose, trajectory[i2].pose);
+    (*valid)[k] = true;
+  }
+}
+
+TimingFit fitTimingOffset(const std::vector<Relation>& relations, const std::vector<Pose2D>& estimated,
+                          const std::vector<bool>& valid, const std::vector<StampedPose>& turn_rates,
+                          double max_span) {
+  const double h = TimingFit::kTurnRateHalfWindow;
+  const auto turn_rate = [&](double stamp, double* rate) {
+    double before = 0.0, after = 0.0;
+    if (!headingAt(turn_rates, stamp - h, &before) || !headingAt(turn_rates, stamp + h, &after)) return false;
+    *rate = normalizeAngle(after - before) / (2.0 * h);
+    return true;
+  };
+  std::vector<double> changes, errors;
+  for (std::size_t k = 0; k < relations.size() && k < estimated.size() && k < valid.size(); ++k) {
+    const Relation& relation = relations[k];
+    if (!valid[k] || (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span)) continue;
+    double rate1 = 0.0, rate2 = 0.0;
+    if (!turn_rate(relation.t1, &rate1) || !turn_rate(relation.t2, &rate2)) continue;
+    const double error = normalizeAngle(estimated[k].theta - relation.motion.theta);
+    if (!(std::abs(error) <= TimingFit::kMaxHeadingError)) continue;
+    changes.push_back(rate2 - rate1);
+    errors.push_back(error);
+  }
+  TimingFit fit;
+  double xx = 0.0, xy = 0.0;
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    xx += changes[i] * changes[i];
+    xy += changes[i] * errors[i];
+  }
+  fit.count = static_cast<int>(changes.size());
+  if (fit.count < 2 || !(xx > 0.0)) return fit;
+  fit.offset = xy / xx;
+  double residual_sq = 0.0;
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    const double residual = errors[i] - fit.offset * changes[i];
+    residual_sq += residual * residual;
+  }
+  fit.offset_sd = std::sqrt(residual_sq / (fit.count - 1) / xx);
+  fit.rate_change = std::sqrt(xx / fit.count);
+  return fit;
 }
 
 std::vector<RelationError> relationErrors(const std::vector<Relation>& relations,

@@ -133,12 +133,25 @@ RelationsReport evaluateRun(const std::vector<hglasm::Relation>& relations, cons
     report.laser_frame_short = hglasm::evaluateRelations(relations, laser, short_span);
     report.wheel_laser_frame_short = hglasm::evaluateRelations(relations, wheel, short_span);
   }
+  // Turn rates from the wheels where there are any: their timing is the bag's, not the fusion's.
+  const std::vector<hglasm::StampedPose>& turn_rates =
+      wheel_trajectory.empty() ? run.trajectory : wheel_trajectory;
+  const auto timing = [&](const std::vector<hglasm::StampedPose>& trajectory) {
+    std::vector<hglasm::Pose2D> motions;
+    std::vector<bool> valid;
+    hglasm::relativeMotions(relations, trajectory, &motions, &valid);
+    return hglasm::fitTimingOffset(relations, motions, valid, turn_rates, short_span);
+  };
+  report.has_timing = true;
+  report.laser_timing = timing(run.trajectory);
+  if (!wheel_trajectory.empty()) report.wheel_timing = timing(wheel_trajectory);
   if (direct_pairs_options) {
     std::vector<hglasm::Pose2D> motions;
     std::vector<bool> valid;
     directPairMotions(*direct_pairs_options, data, relations, short_span, &motions, &valid);
     report.has_direct_pairs = true;
     report.direct_pairs = hglasm::evaluateRelativeMotions(relations, motions, valid, short_span);
+    report.direct_pairs_timing = hglasm::fitTimingOffset(relations, motions, valid, turn_rates, short_span);
   }
   report.calibration =
       hglasm::evaluateCalibration(relations, run.trajectory, incrementCovariances(run), short_span);
@@ -198,6 +211,22 @@ void printRun(std::FILE* out, const EvaluationRun& run, double data_seconds, boo
   printTimes(out, run, data_seconds);
 }
 
+namespace {
+
+void printTiming(std::FILE* out, const char* short_label, const RelationsReport& report, bool has_wheel) {
+  const auto print = [&](const char* name, const hglasm::TimingFit& fit) {
+    std::fprintf(out, "%s %+.0f +- %.0f ms (%d)", name, 1e3 * fit.offset, 1e3 * fit.offset_sd, fit.count);
+  };
+  std::fprintf(out, "  timing %s: heading error = offset x change of turn rate (wheels'), offset of ",
+               short_label);
+  print("laser", report.laser_timing);
+  if (has_wheel) print(", wheels", report.wheel_timing);
+  if (report.has_direct_pairs) print(", direct pairs", report.direct_pairs_timing);
+  std::fprintf(out, "\n");
+}
+
+}  // namespace
+
 void printRelationsReport(std::FILE* out, const std::string& relations_path,
                           const std::vector<hglasm::Relation>& relations, const RelationsReport& report,
                           const std::string& base_frame, bool has_wheel) {
@@ -227,6 +256,7 @@ void printRelationsReport(std::FILE* out, const std::string& relations_path,
                  short_label, direct.count, direct.missing, direct.trans_mean, direct.trans_std,
                  direct.rot_mean_deg, direct.rot_std_deg);
   }
+  if (report.has_timing) printTiming(out, short_label, report, has_wheel);
   const hglasm::CalibrationStats& calibration = report.calibration;
   std::fprintf(
       out,
@@ -261,7 +291,8 @@ void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun
       "wheel_all_r=%.3f wheel_short_t=%.4f wheel_short_r=%.3f laser_frame_short_t=%.4f "
       "laser_frame_short_r=%.3f calibration=%.3f worst_leap=%.3f time_offset=%.3f resets=%d keyframes=%d "
       "short_t_median=%.4f short_r_median=%.3f wheel_short_t_median=%.4f wheel_short_r_median=%.3f "
-      "short_scale=%.4f wheel_short_scale=%.4f all_scale=%.4f wheel_all_scale=%.4f\n",
+      "short_scale=%.4f wheel_short_scale=%.4f all_scale=%.4f wheel_all_scale=%.4f timing_ms=%.1f "
+      "wheel_timing_ms=%.1f\n",
       preset.c_str(), scans, run.fallbacks, scans ? 100.0 * run.fallbacks / scans : 0.0, total.median,
       total.p99, total.max, r.laser_all.trans_mean, r.laser_all.rot_mean_deg, r.laser_short.trans_mean,
       r.laser_short.rot_mean_deg, r.wheel_all.trans_mean, r.wheel_all.rot_mean_deg, r.wheel_short.trans_mean,
@@ -269,7 +300,8 @@ void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun
       r.calibration.mean_sq_mahalanobis, r.worst_leap_ratio, run.time_offset, run.resets, run.keyframes,
       r.laser_short.trans_median, r.laser_short.rot_median_deg, r.wheel_short.trans_median,
       r.wheel_short.rot_median_deg, r.laser_short.along_track_scale, r.wheel_short.along_track_scale,
-      r.laser_all.along_track_scale, r.wheel_all.along_track_scale);
+      r.laser_all.along_track_scale, r.wheel_all.along_track_scale, 1e3 * r.laser_timing.offset,
+      1e3 * r.wheel_timing.offset);
 }
 
 }  // namespace hglasm_odometry

@@ -307,5 +307,66 @@ TEST(Relations, PerRelationErrorsInTheOrderOfTheRelations) {
   EXPECT_NEAR(errors[1].trans, 0.1, 1e-12);
 }
 
+/// A robot driving at 0.5 m/s whose turn rate swings as 0.5 sin(0.3 t) rad/s, its pose at time t (exact).
+Pose2D swingingPoseAt(double t) {
+  // theta(t) = (0.5 / 0.3) (1 - cos(0.3 t)); the position integrated finely (the fit reads headings only).
+  Pose2D pose;
+  const int steps = static_cast<int>(std::round(t / 0.01));
+  for (int i = 0; i < steps; ++i) {
+    const double heading = (0.5 / 0.3) * (1.0 - std::cos(0.3 * (i + 0.5) * 0.01));
+    pose.x += 0.005 * std::cos(heading);
+    pose.y += 0.005 * std::sin(heading);
+  }
+  pose.theta = (0.5 / 0.3) * (1.0 - std::cos(0.3 * t));
+  return pose;
+}
+
+TEST(Timing, AnEstimateReadAFewMillisecondsLateFitsThatOffset) {
+  std::vector<StampedPose> truth, late, early;
+  for (int i = 0; i <= 600; ++i) {  // 60 s at 10 Hz
+    const double t = 0.1 * i;
+    truth.push_back({t, swingingPoseAt(t)});
+    late.push_back({t, swingingPoseAt(t + 0.05)});
+    early.push_back({t, swingingPoseAt(t - 0.03)});
+  }
+  std::vector<Relation> relations;
+  for (std::size_t i = 10; i + 40 < truth.size(); i += 7) {  // turn rates known 0.3 s around
+    relations.push_back(
+        {truth[i].stamp, truth[i + 30].stamp, relativePose(truth[i].pose, truth[i + 30].pose)});
+  }
+  const auto fit = [&](const std::vector<StampedPose>& estimate) {
+    std::vector<Pose2D> motions;
+    std::vector<bool> valid;
+    relativeMotions(relations, estimate, &motions, &valid);
+    return fitTimingOffset(relations, motions, valid, truth, 10.0);
+  };
+  const TimingFit exact = fit(truth), read_late = fit(late), read_early = fit(early);
+  EXPECT_EQ(exact.count, static_cast<int>(relations.size()));
+  EXPECT_NEAR(exact.offset, 0.0, 1e-9);
+  EXPECT_NEAR(read_late.offset, 0.05, 0.002);
+  EXPECT_NEAR(read_early.offset, -0.03, 0.002);
+  EXPECT_GT(read_late.rate_change, 0.1);  // the relations do see the turn rate change
+}
+
+TEST(Timing, LeapsAndRelationsWithoutTurnRatesAreLeftOut) {
+  std::vector<StampedPose> truth;
+  for (int i = 0; i <= 100; ++i) truth.push_back({0.1 * i, swingingPoseAt(0.1 * i)});
+  const std::vector<Relation> relations = {
+      {2.0, 4.0, relativePose(truth[20].pose, truth[40].pose)},  // fitted
+      {4.0, 6.0, relativePose(truth[40].pose, truth[60].pose)},  // fitted
+      {5.0, 7.0, relativePose(truth[50].pose, truth[70].pose)},  // a 10 degree leap: left out
+      {0.1, 2.0, relativePose(truth[1].pose, truth[20].pose)},   // no turn rate 0.3 s before t1
+      {2.0, 9.0, relativePose(truth[20].pose, truth[90].pose)}   // longer than the span
+  };
+  std::vector<Pose2D> motions;
+  std::vector<bool> valid;
+  relativeMotions(relations, truth, &motions, &valid);
+  ASSERT_EQ(valid, std::vector<bool>(5, true));
+  motions[2].theta += 10.0 / kRadToDeg;
+  const TimingFit fit = fitTimingOffset(relations, motions, valid, truth, 5.0);
+  EXPECT_EQ(fit.count, 2);
+  EXPECT_NEAR(fit.offset, 0.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace hglasm

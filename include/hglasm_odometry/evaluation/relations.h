@@ -52,6 +52,28 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
                                       const std::vector<Pose2D>& estimated, const std::vector<bool>& valid,
                                       double max_span);
 
+/// The relative motions of `trajectory` between each relation's stamps (valid[k] false where a stamp is not
+/// in it within `stamp_tolerance`).
+void relativeMotions(const std::vector<Relation>& relations, const std::vector<StampedPose>& trajectory,
+                     std::vector<Pose2D>* estimated, std::vector<bool>* valid, double stamp_tolerance = 1e-3);
+
+/// Whether an estimate's clock agrees with the reference's. An estimate whose pose at stamp t is the robot's
+/// at t + offset has heading errors offset x (turn rate at t2 - turn rate at t1) over a relation; the offset
+/// is fitted by least squares over the relations spanning at most `max_span` s (<= 0: all). Turn rates come
+/// from `turn_rates` (a trajectory, e.g. the wheels', differenced over +-kTurnRateHalfWindow s).
+/// Relations whose heading error exceeds kMaxHeadingError are left out (a leap is not a timing).
+struct TimingFit {
+  int count = 0;             ///< relations fitted
+  double offset = 0.0;       ///< seconds; > 0: the estimate's pose at t is the reference's at a later time
+  double offset_sd = 0.0;    ///< its standard error, seconds
+  double rate_change = 0.0;  ///< rad/s: root mean square change of turn rate over the fitted relations
+  static constexpr double kTurnRateHalfWindow = 0.3;  ///< seconds
+  static constexpr double kMaxHeadingError = 0.05;    ///< radians (about 3 degrees)
+};
+TimingFit fitTimingOffset(const std::vector<Relation>& relations, const std::vector<Pose2D>& estimated,
+                          const std::vector<bool>& valid, const std::vector<StampedPose>& turn_rates,
+                          double max_span);
+
 /// One relation's error (the residual estimated ⊖ reference).
 struct RelationError {
   std::size_t index = 0;  ///< into the relations

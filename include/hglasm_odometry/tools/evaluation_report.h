@@ -30,6 +30,9 @@ struct RelationsReport {
   hglasm::RelationStats laser_frame_all, wheel_laser_frame_all, laser_frame_short, wheel_laser_frame_short;
   bool has_direct_pairs = false;
   hglasm::RelationStats direct_pairs;  ///< short relations, each scan pair matched on its own
+  /// Each estimate's clock against the reference's over the short relations (turn rates from the wheels).
+  bool has_timing = false;
+  hglasm::TimingFit laser_timing, wheel_timing, direct_pairs_timing;
   hglasm::CalibrationStats calibration;
   std::vector<WorstRelation> worst;  ///< the five largest short errors, largest first
   double worst_leap_ratio = 0.0;     ///< largest laser / (3 x wheel + 0.10 m): above 1 is a leap
