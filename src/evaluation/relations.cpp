@@ -192,6 +192,25 @@ TimingFit fitTimingOffset(const std::vector<Relation>& relations, const std::vec
   return fit;
 }
 
+std::vector<bool> contradictedRelations(const std::vector<Relation>& relations,
+                                        const std::vector<Pose2D>& direct,
+                                        const std::vector<bool>& direct_valid,
+                                        const std::vector<Pose2D>& witness,
+                                        const std::vector<bool>& witness_valid, double max_span,
+                                        double min_disagreement, double max_agreement) {
+  std::vector<bool> contradicted(relations.size(), false);
+  for (std::size_t k = 0; k < relations.size(); ++k) {
+    const Relation& relation = relations[k];
+    if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
+    if (k >= direct.size() || k >= direct_valid.size() || !direct_valid[k]) continue;
+    if (k >= witness.size() || k >= witness_valid.size() || !witness_valid[k]) continue;
+    const double from_reference = std::abs(normalizeAngle(direct[k].theta - relation.motion.theta));
+    const double from_witness = std::abs(normalizeAngle(direct[k].theta - witness[k].theta));
+    contradicted[k] = from_reference > min_disagreement && from_witness <= max_agreement;
+  }
+  return contradicted;
+}
+
 std::vector<RelationError> relationErrors(const std::vector<Relation>& relations,
                                           const std::vector<StampedPose>& trajectory, double max_span,
                                           double stamp_tolerance) {

@@ -41,7 +41,9 @@ const char kUsage[] =
     "  --max-span S            short-relation span for the second metric row (default 10 s)\n"
     "  --direct-pairs          also match each relation's own scan pair directly (MbICP started from the\n"
     "                          reference motion): how closely any one-shot match of the very scans the\n"
-    "                          reference aligned can agree with it, the floor of the relations metric\n"
+    "                          reference aligned can agree with it, the floor of the relations metric;\n"
+    "                          and the relations those scans and the wheels agree against (> 3 deg off\n"
+    "                          the reference's turn, within 1 deg of each other), with the metric without them\n"
     "  --quiet                 no per-warning output\n";
 
 bool exists(const std::string& path) { return std::ifstream(path).good(); }

@@ -110,6 +110,31 @@ void printTimes(std::FILE* out, const EvaluationRun& run, double data_seconds) {
                cpu_seconds > 0.0 ? data_seconds / cpu_seconds : 0.0);
 }
 
+/// The short relations the scans and the wheels agree against, and the metric without them.
+void judgeReference(const std::vector<hglasm::Relation>& relations, const EvaluationRun& run,
+                    const std::vector<hglasm::StampedPose>& wheel_trajectory,
+                    const std::vector<hglasm::Pose2D>& direct, const std::vector<bool>& direct_valid,
+                    RelationsReport* report) {
+  std::vector<hglasm::Pose2D> wheels;
+  std::vector<bool> wheels_valid;
+  hglasm::relativeMotions(relations, wheel_trajectory, &wheels, &wheels_valid);
+  const std::vector<bool> contradicted =
+      hglasm::contradictedRelations(relations, direct, direct_valid, wheels, wheels_valid, report->short_span,
+                                    RelationsReport::kContradiction, RelationsReport::kAgreement);
+  std::vector<hglasm::Relation> rest;
+  for (std::size_t k = 0; k < relations.size(); ++k) {
+    if (contradicted[k]) {
+      ++report->contradicted;
+    } else {
+      rest.push_back(relations[k]);
+    }
+  }
+  report->laser_short_uncontradicted = hglasm::evaluateRelations(rest, run.trajectory, report->short_span);
+  report->wheel_short_uncontradicted = hglasm::evaluateRelations(rest, wheel_trajectory, report->short_span);
+  report->calibration_uncontradicted =
+      hglasm::evaluateCalibration(rest, run.trajectory, incrementCovariances(run), report->short_span);
+}
+
 }  // namespace
 
 RelationsReport evaluateRun(const std::vector<hglasm::Relation>& relations, const EvaluationRun& run,
@@ -152,6 +177,7 @@ RelationsReport evaluateRun(const std::vector<hglasm::Relation>& relations, cons
     report.has_direct_pairs = true;
     report.direct_pairs = hglasm::evaluateRelativeMotions(relations, motions, valid, short_span);
     report.direct_pairs_timing = hglasm::fitTimingOffset(relations, motions, valid, turn_rates, short_span);
+    if (!wheel_trajectory.empty()) judgeReference(relations, run, wheel_trajectory, motions, valid, &report);
   }
   report.calibration =
       hglasm::evaluateCalibration(relations, run.trajectory, incrementCovariances(run), short_span);
@@ -213,6 +239,22 @@ void printRun(std::FILE* out, const EvaluationRun& run, double data_seconds, boo
 
 namespace {
 
+void printContradicted(std::FILE* out, const char* short_label, const RelationsReport& report,
+                       bool has_wheel) {
+  if (!has_wheel) return;
+  const hglasm::RelationStats& laser = report.laser_short_uncontradicted;
+  const hglasm::RelationStats& wheel = report.wheel_short_uncontradicted;
+  std::fprintf(
+      out,
+      "  contradicted: %d relations %s whose direct pair settles > %.0f deg from the reference's turn "
+      "and within %.0f deg of the wheels'; without them (%d): laser %.4f / %.3f (median %.4f / %.3f), "
+      "wheels %.4f / %.3f (median %.4f / %.3f), calibration %.2f\n",
+      report.contradicted, short_label, RelationsReport::kContradiction * 180.0 / M_PI,
+      RelationsReport::kAgreement * 180.0 / M_PI, laser.count, laser.trans_mean, laser.rot_mean_deg,
+      laser.trans_median, laser.rot_median_deg, wheel.trans_mean, wheel.rot_mean_deg, wheel.trans_median,
+      wheel.rot_median_deg, report.calibration_uncontradicted.mean_sq_mahalanobis);
+}
+
 void printTiming(std::FILE* out, const char* short_label, const RelationsReport& report, bool has_wheel) {
   const auto print = [&](const char* name, const hglasm::TimingFit& fit) {
     std::fprintf(out, "%s %+.0f +- %.0f ms (%d)", name, 1e3 * fit.offset, 1e3 * fit.offset_sd, fit.count);
@@ -255,6 +297,7 @@ void printRelationsReport(std::FILE* out, const std::string& relations_path,
                  "  %-9s %5d %7d | %.4f +- %.4f  %6.3f +- %6.3f  (missing: no scan or no converged match)\n",
                  short_label, direct.count, direct.missing, direct.trans_mean, direct.trans_std,
                  direct.rot_mean_deg, direct.rot_std_deg);
+    printContradicted(out, short_label, report, has_wheel);
   }
   if (report.has_timing) printTiming(out, short_label, report, has_wheel);
   const hglasm::CalibrationStats& calibration = report.calibration;

@@ -368,5 +368,25 @@ TEST(Timing, LeapsAndRelationsWithoutTurnRatesAreLeftOut) {
   EXPECT_NEAR(fit.offset, 0.0, 1e-9);
 }
 
+TEST(Relations, ARelationIsContradictedWhenItsScansAndTheWheelsAgreeAgainstIt) {
+  const double deg = M_PI / 180.0;
+  const std::vector<Relation> relations = {
+      {0.0, 2.0, Pose2D(1.0, 0.0, 10.0 * deg)},  // scans and wheels both say 0 deg: contradicted
+      {0.0, 2.0, Pose2D(1.0, 0.0, 10.0 * deg)},  // scans say 0, wheels 5: no witness agrees
+      {0.0, 2.0, Pose2D(1.0, 0.0, 2.0 * deg)},   // scans 2 deg from the reference: within its error
+      {0.0, 2.0, Pose2D(1.0, 0.0, 10.0 * deg)},  // no direct match
+      {0.0, 20.0, Pose2D(1.0, 0.0, 10.0 * deg)}  // longer than the span
+  };
+  const std::vector<Pose2D> direct = {Pose2D(1.0, 0.0, 0.0), Pose2D(1.0, 0.0, 0.0), Pose2D(1.0, 0.0, 0.0),
+                                      Pose2D(), Pose2D(1.0, 0.0, 0.0)};
+  const std::vector<bool> direct_valid = {true, true, true, false, true};
+  const std::vector<Pose2D> wheels = {Pose2D(1.0, 0.0, 0.5 * deg), Pose2D(1.0, 0.0, 5.0 * deg),
+                                      Pose2D(1.0, 0.0, 0.0), Pose2D(1.0, 0.0, 0.0), Pose2D(1.0, 0.0, 0.0)};
+  const std::vector<bool> wheels_valid(5, true);
+  const std::vector<bool> contradicted = contradictedRelations(relations, direct, direct_valid, wheels,
+                                                               wheels_valid, 10.0, 3.0 * deg, 1.0 * deg);
+  EXPECT_EQ(contradicted, std::vector<bool>({true, false, false, false, false}));
+}
+
 }  // namespace
 }  // namespace hglasm

@@ -74,6 +74,18 @@ TimingFit fitTimingOffset(const std::vector<Relation>& relations, const std::vec
                           const std::vector<bool>& valid, const std::vector<StampedPose>& turn_rates,
                           double max_span);
 
+/// The relations (spanning at most `max_span` s; <= 0: all) that their own scans contradict: the scans
+/// matched on their own from the reference's motion (`direct`) settle more than `min_disagreement` rad from
+/// the reference's turn and within `max_agreement` rad of an independent witness's (`witness`, e.g. the
+/// wheels'). A reference built by hand can be wrong; where the scans and the wheels agree against it, it
+/// likely is.
+std::vector<bool> contradictedRelations(const std::vector<Relation>& relations,
+                                        const std::vector<Pose2D>& direct,
+                                        const std::vector<bool>& direct_valid,
+                                        const std::vector<Pose2D>& witness,
+                                        const std::vector<bool>& witness_valid, double max_span,
+                                        double min_disagreement, double max_agreement);
+
 /// One relation's error (the residual estimated ⊖ reference).
 struct RelationError {
   std::size_t index = 0;  ///< into the relations
