@@ -4,7 +4,6 @@
 #pragma once
 
 #include <cmath>
-
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -32,7 +31,6 @@ struct RelationsReport {
   hglasm::RelationStats laser_frame_all, wheel_laser_frame_all, laser_frame_short, wheel_laser_frame_short;
   bool has_direct_pairs = false;
   hglasm::RelationStats direct_pairs;  ///< short relations, each scan pair matched on its own
-  /// Each estimate's clock against the reference's over the short relations (turn rates from the wheels).
   /// Short relations their own scans contradict (the direct pairs more than kContradiction from the
   /// reference's turn and within kAgreement of the wheels'), and the metric over the rest.
   int contradicted = 0;
@@ -40,6 +38,7 @@ struct RelationsReport {
   hglasm::CalibrationStats calibration_uncontradicted;
   static constexpr double kContradiction = 3.0 * M_PI / 180.0;  ///< radians
   static constexpr double kAgreement = 1.0 * M_PI / 180.0;      ///< radians
+  /// Each estimate's clock against the reference's over the short relations (turn rates from the wheels).
   bool has_timing = false;
   hglasm::TimingFit laser_timing, wheel_timing, direct_pairs_timing;
   hglasm::CalibrationStats calibration;
