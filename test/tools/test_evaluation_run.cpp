@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -150,6 +151,34 @@ TEST(EvaluationReport, PrintsTheMetricAndTheSummaryOfTheRun) {
   std::snprintf(all, sizeof all, " all_t=%.4f all_r=%.3f ", report.laser_all.trans_mean,
                 report.laser_all.rot_mean_deg);
   EXPECT_NE(text.find(all), std::string::npos) << text;
+}
+
+TEST(EvaluationReport, TimesEachEstimateAgainstTheReferencesClockAndJudgesTheReference) {
+  const Slice& s = slice();
+  const std::vector<hglasm::StampedPose> wheel = wheelTrajectory(s.data);
+  const RelationsReport report = evaluateRun(s.relations, run(), wheel, s.data, 10.0, &s.options.tracker);
+  ASSERT_TRUE(report.has_timing);
+  // fr079's wheels run about a tenth of a second behind the scans, which keep the reference's clock.
+  EXPECT_GT(report.wheel_timing.count, 30);
+  EXPECT_NEAR(report.wheel_timing.offset, 0.11, 0.04);
+  EXPECT_LT(std::abs(report.laser_timing.offset), 0.02);
+  EXPECT_LT(std::abs(report.direct_pairs_timing.offset), 0.02);
+  // Nothing in this slice is contradicted by its scans and wheels together: the rest is everything.
+  EXPECT_EQ(report.contradicted, 0);
+  EXPECT_EQ(report.laser_short_uncontradicted.count, report.laser_short.count);
+  EXPECT_DOUBLE_EQ(report.calibration_uncontradicted.mean_sq_mahalanobis,
+                   report.calibration.mean_sq_mahalanobis);
+
+  const std::string text = printed([&](std::FILE* out) {
+    printRelationsReport(out, "r.relations", s.relations, report, "base_link", true);
+    printSummary(out, "medium", run(), report);
+  });
+  EXPECT_NE(text.find("  timing <= 10 s: heading error = offset x change of turn rate"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("  contradicted: 0 relations <= 10 s"), std::string::npos) << text;
+  char timing[64];
+  std::snprintf(timing, sizeof timing, " wheel_timing_ms=%.1f\n", 1e3 * report.wheel_timing.offset);
+  EXPECT_NE(text.find(timing), std::string::npos) << text;
 }
 
 TEST(EvaluationReport, PrintsTheRunWithItsWarningsWhenAsked) {
