@@ -43,7 +43,8 @@ const char kUsage[] =
     "                          reference motion): how closely any one-shot match of the very scans the\n"
     "                          reference aligned can agree with it, the floor of the relations metric;\n"
     "                          and the relations those scans and the wheels agree against (> 3 deg off\n"
-    "                          the reference's turn, within 1 deg of each other), with the metric without them\n"
+    "                          the reference's turn, within 1 deg of each other), and the metric\n"
+    "                          without them\n"
     "  --quiet                 no per-warning output\n";
 
 bool exists(const std::string& path) { return std::ifstream(path).good(); }
