@@ -18,19 +18,19 @@ double likelihoodWeight(double independent_points, std::size_t points, double ev
 }
 
 ScanJudge::ScanJudge(const LookupTable& table, const Scan& scan, double weight, double outlier)
-    : table_(&table), scan_(&scan), weight_(weight), outlier_(outlier) {}
+    : table_(&table), scan_(&scan), weight_(weight), outlier_(outlier) {
+  points_.assign(scan.points);
+}
 
 double ScanJudge::fitnessRatio(const Pose2D& pose) const {
   if (!usable()) return 0.0;
   const double best = static_cast<double>(table_->maxCellValue()) * static_cast<double>(scan_->size());
-  return table_->fitness(scan_->points, pose) / best;
+  return table_->fitness(points_, pose) / best;
 }
 
 double ScanJudge::logLikelihood(const Pose2D& pose) const {
   if (!usable()) return 0.0;
-  FitnessPoints points;
-  points.assign(scan_->points);
-  return weight_ * table_->logLikelihood(points, pose, outlier_);
+  return weight_ * table_->logLikelihood(points_, pose, outlier_);
 }
 
 double ScanJudge::freeSpaceLogLikelihood(const Pose2D& pose) const {

@@ -426,6 +426,8 @@ int LookupTable::beamsThroughSurfaces(const std::vector<Eigen::Vector2d>& points
 void FitnessPoints::assign(const std::vector<Eigen::Vector2d>& points) {
   x.clear();
   y.clear();
+  x.reserve(points.size());
+  y.reserve(points.size());
   for (const auto& p : points) {
     if (!p.allFinite()) continue;
     x.push_back(static_cast<float>(p.x()));

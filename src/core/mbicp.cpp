@@ -489,9 +489,10 @@ double Mbicp::informationScale(double constraints) const {
   return std::min(1.0, options_.independent_points / constraints);
 }
 
-double Mbicp::robustScaleSq() const {
+double Mbicp::robustScaleSq() {
   if (!(options_.robust_scale > 0.0) || associations_.empty()) return 0.0;
-  std::vector<double> distance_sq(associations_.size());
+  std::vector<double>& distance_sq = distance_sq_;
+  distance_sq.resize(associations_.size());
   for (std::size_t i = 0; i < distance_sq.size(); ++i) distance_sq[i] = associations_[i].distance_sq;
   auto median = distance_sq.begin() + distance_sq.size() / 2;
   std::nth_element(distance_sq.begin(), median, distance_sq.end());

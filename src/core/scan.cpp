@@ -103,6 +103,7 @@ constexpr double kMaxJoinStep = 2.0 * M_PI / 180.0;
 double medianAngularStep(const std::vector<Eigen::Vector2d>& points, std::size_t begin, std::size_t end,
                          const Eigen::Vector2d& origin) {
   std::vector<double> steps;
+  steps.reserve(end > begin ? end - begin : 0);
   for (std::size_t i = begin; i + 1 < end; ++i) {
     if (!points[i].allFinite() || !points[i + 1].allFinite()) continue;
     const Eigen::Vector2d a = points[i] - origin, b = points[i + 1] - origin;

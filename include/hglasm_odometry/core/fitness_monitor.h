@@ -45,6 +45,7 @@ class ScanJudge {
 
   const LookupTable* table_;
   const Scan* scan_;
+  FitnessPoints points_;  // the scan's finite points, prepared once for every pose judged
   double weight_;
   double outlier_;
 };

@@ -209,7 +209,7 @@ class Mbicp {
   int walkStart(double bearing) const;
   void associate(const std::vector<Eigen::Vector2d>& moved, double gate, std::vector<Association>* out);
   /// c^2 of the robust weights for the current associations (0: no weights).
-  double robustScaleSq() const;
+  double robustScaleSq();
   /// The d_ap metric of one association (to its segment's line, or weighed against an isolated reference
   /// point's sampling), and its squared residual under it.
   Eigen::Matrix2d associationMetric(const Association& assoc, bool settled, double l_sq,
@@ -239,6 +239,7 @@ class Mbicp {
   ScanNoiseScale scan_noise_scale_ = ScanNoiseScale::Ones();
   std::vector<Eigen::Vector2d> moved_;   // scratch
   std::vector<Eigen::Vector2d> points_;  // scratch: the scan's points matched
+  std::vector<double> distance_sq_;      // scratch: the associations' squared distances
   std::vector<int> warm_entry_;          // per point: the walk entry of its last association (-1: none)
 };
 
