@@ -16,12 +16,28 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
+/// The first pose of `trajectory` (sorted by stamp) stamped at or after `stamp`.
+std::vector<StampedPose>::const_iterator firstAtOrAfter(const std::vector<StampedPose>& trajectory,
+                                                        double stamp) {
+  return std::lower_bound(trajectory.begin(), trajectory.end(), stamp,
+                          [](const StampedPose& pose, double value) { return pose.stamp < value; });
+}
+
+/// Whether a relation spans at most `max_span` seconds (<= 0: any span).
+bool withinSpan(const Relation& relation, double max_span) {
+  return !(max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span);
+}
+
+/// Whether the k-th of per-relation estimates exists and is valid.
+template <typename Estimate>
+bool validAt(const std::vector<Estimate>& estimates, const std::vector<bool>& valid, std::size_t k) {
+  return k < estimates.size() && k < valid.size() && valid[k];
+}
+
 /// Index of the trajectory pose whose stamp is nearest to `stamp` if within `tolerance`, else -1.
 /// `trajectory` is sorted by stamp.
 long findStamp(const std::vector<StampedPose>& trajectory, double stamp, double tolerance) {
-  const auto after =
-      std::lower_bound(trajectory.begin(), trajectory.end(), stamp,
-                       [](const StampedPose& pose, double value) { return pose.stamp < value; });
+  const auto after = firstAtOrAfter(trajectory, stamp);
   long best = -1;
   double best_gap = tolerance;
   // The nearest stamp is either the first one at or after `stamp` or the one just before it.
@@ -38,9 +54,7 @@ long findStamp(const std::vector<StampedPose>& trajectory, double stamp, double 
 
 /// The heading of `trajectory` (sorted by stamp) at `stamp`, interpolated between the samples around it.
 bool headingAt(const std::vector<StampedPose>& trajectory, double stamp, double* heading) {
-  const auto after =
-      std::lower_bound(trajectory.begin(), trajectory.end(), stamp,
-                       [](const StampedPose& pose, double value) { return pose.stamp < value; });
+  const auto after = firstAtOrAfter(trajectory, stamp);
   if (after == trajectory.begin() || after == trajectory.end()) return false;
   const StampedPose& a = *std::prev(after);
   const StampedPose& b = *after;
@@ -100,8 +114,8 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
   double along = 0.0, reference_distance = 0.0;
   for (std::size_t k = 0; k < relations.size(); ++k) {
     const Relation& relation = relations[k];
-    if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
-    if (k >= estimated.size() || k >= valid.size() || !valid[k]) {
+    if (!withinSpan(relation, max_span)) continue;
+    if (!validAt(estimated, valid, k)) {
       ++stats.missing;
       continue;
     }
@@ -163,9 +177,9 @@ TimingFit fitTimingOffset(const std::vector<Relation>& relations, const std::vec
     return true;
   };
   std::vector<double> changes, errors;
-  for (std::size_t k = 0; k < relations.size() && k < estimated.size() && k < valid.size(); ++k) {
+  for (std::size_t k = 0; k < relations.size(); ++k) {
     const Relation& relation = relations[k];
-    if (!valid[k] || (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span)) continue;
+    if (!validAt(estimated, valid, k) || !withinSpan(relation, max_span)) continue;
     double rate1 = 0.0, rate2 = 0.0;
     if (!turn_rate(relation.t1, &rate1) || !turn_rate(relation.t2, &rate2)) continue;
     const double error = normalizeAngle(estimated[k].theta - relation.motion.theta);
@@ -201,9 +215,8 @@ std::vector<bool> contradictedRelations(const std::vector<Relation>& relations,
   std::vector<bool> contradicted(relations.size(), false);
   for (std::size_t k = 0; k < relations.size(); ++k) {
     const Relation& relation = relations[k];
-    if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
-    if (k >= direct.size() || k >= direct_valid.size() || !direct_valid[k]) continue;
-    if (k >= witness.size() || k >= witness_valid.size() || !witness_valid[k]) continue;
+    if (!withinSpan(relation, max_span)) continue;
+    if (!validAt(direct, direct_valid, k) || !validAt(witness, witness_valid, k)) continue;
     const double from_reference = std::abs(normalizeAngle(direct[k].theta - relation.motion.theta));
     const double from_witness = std::abs(normalizeAngle(direct[k].theta - witness[k].theta));
     contradicted[k] = from_reference > min_disagreement && from_witness <= max_agreement;
@@ -217,7 +230,7 @@ std::vector<RelationError> relationErrors(const std::vector<Relation>& relations
   std::vector<RelationError> errors;
   for (std::size_t k = 0; k < relations.size(); ++k) {
     const Relation& relation = relations[k];
-    if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
+    if (!withinSpan(relation, max_span)) continue;
     const long i1 = findStamp(trajectory, relation.t1, stamp_tolerance);
     const long i2 = findStamp(trajectory, relation.t2, stamp_tolerance);
     if (i1 < 0 || i2 < 0) continue;
@@ -236,7 +249,7 @@ CalibrationStats evaluateCalibration(const std::vector<Relation>& relations,
   if (increment_covariances.size() != trajectory.size()) return stats;
   std::vector<double> distances;
   for (const Relation& relation : relations) {
-    if (max_span > 0.0 && std::abs(relation.t2 - relation.t1) > max_span) continue;
+    if (!withinSpan(relation, max_span)) continue;
     const long i1 = findStamp(trajectory, relation.t1, stamp_tolerance);
     const long i2 = findStamp(trajectory, relation.t2, stamp_tolerance);
     if (i1 < 0 || i2 <= i1) continue;

@@ -110,17 +110,26 @@ void printTimes(std::FILE* out, const EvaluationRun& run, double data_seconds) {
                cpu_seconds > 0.0 ? data_seconds / cpu_seconds : 0.0);
 }
 
+/// Per-relation motions of one estimate (valid[k]: relation k's stamps are in it).
+struct RelativeMotions {
+  std::vector<hglasm::Pose2D> motions;
+  std::vector<bool> valid;
+};
+
+RelativeMotions relativeMotionsOf(const std::vector<hglasm::Relation>& relations,
+                                  const std::vector<hglasm::StampedPose>& trajectory) {
+  RelativeMotions result;
+  hglasm::relativeMotions(relations, trajectory, &result.motions, &result.valid);
+  return result;
+}
+
 /// The short relations the scans and the wheels agree against, and the metric without them.
 void judgeReference(const std::vector<hglasm::Relation>& relations, const EvaluationRun& run,
-                    const std::vector<hglasm::StampedPose>& wheel_trajectory,
-                    const std::vector<hglasm::Pose2D>& direct, const std::vector<bool>& direct_valid,
-                    RelationsReport* report) {
-  std::vector<hglasm::Pose2D> wheels;
-  std::vector<bool> wheels_valid;
-  hglasm::relativeMotions(relations, wheel_trajectory, &wheels, &wheels_valid);
-  const std::vector<bool> contradicted =
-      hglasm::contradictedRelations(relations, direct, direct_valid, wheels, wheels_valid, report->short_span,
-                                    RelationsReport::kContradiction, RelationsReport::kAgreement);
+                    const std::vector<hglasm::StampedPose>& wheel_trajectory, const RelativeMotions& wheels,
+                    const RelativeMotions& direct, RelationsReport* report) {
+  const std::vector<bool> contradicted = hglasm::contradictedRelations(
+      relations, direct.motions, direct.valid, wheels.motions, wheels.valid, report->short_span,
+      RelationsReport::kContradiction, RelationsReport::kAgreement);
   std::vector<hglasm::Relation> rest;
   for (std::size_t k = 0; k < relations.size(); ++k) {
     if (contradicted[k]) {
@@ -161,23 +170,21 @@ RelationsReport evaluateRun(const std::vector<hglasm::Relation>& relations, cons
   // Turn rates from the wheels where there are any: their timing is the bag's, not the fusion's.
   const std::vector<hglasm::StampedPose>& turn_rates =
       wheel_trajectory.empty() ? run.trajectory : wheel_trajectory;
-  const auto timing = [&](const std::vector<hglasm::StampedPose>& trajectory) {
-    std::vector<hglasm::Pose2D> motions;
-    std::vector<bool> valid;
-    hglasm::relativeMotions(relations, trajectory, &motions, &valid);
-    return hglasm::fitTimingOffset(relations, motions, valid, turn_rates, short_span);
+  const auto timing = [&](const RelativeMotions& estimate) {
+    return hglasm::fitTimingOffset(relations, estimate.motions, estimate.valid, turn_rates, short_span);
   };
+  const RelativeMotions wheels = relativeMotionsOf(relations, wheel_trajectory);
   report.has_timing = true;
-  report.laser_timing = timing(run.trajectory);
-  if (!wheel_trajectory.empty()) report.wheel_timing = timing(wheel_trajectory);
+  report.laser_timing = timing(relativeMotionsOf(relations, run.trajectory));
+  if (!wheel_trajectory.empty()) report.wheel_timing = timing(wheels);
   if (direct_pairs_options) {
-    std::vector<hglasm::Pose2D> motions;
-    std::vector<bool> valid;
-    directPairMotions(*direct_pairs_options, data, relations, short_span, &motions, &valid);
+    RelativeMotions direct;
+    directPairMotions(*direct_pairs_options, data, relations, short_span, &direct.motions, &direct.valid);
     report.has_direct_pairs = true;
-    report.direct_pairs = hglasm::evaluateRelativeMotions(relations, motions, valid, short_span);
-    report.direct_pairs_timing = hglasm::fitTimingOffset(relations, motions, valid, turn_rates, short_span);
-    if (!wheel_trajectory.empty()) judgeReference(relations, run, wheel_trajectory, motions, valid, &report);
+    report.direct_pairs =
+        hglasm::evaluateRelativeMotions(relations, direct.motions, direct.valid, short_span);
+    report.direct_pairs_timing = timing(direct);
+    if (!wheel_trajectory.empty()) judgeReference(relations, run, wheel_trajectory, wheels, direct, &report);
   }
   report.calibration =
       hglasm::evaluateCalibration(relations, run.trajectory, incrementCovariances(run), short_span);
