@@ -6,7 +6,8 @@
 # honest), the along-track scale of the <= 10 s relations (laser/wheels: the distance travelled along the
 # reference's direction over the reference's; 1 is unbiased), the leap ratio (largest <= 10 s error /
 # (3 x the wheels' + 0.10 m); above 1 is a leap) and the timing of laser and wheels against the reference
-# (ms: heading error = timing x change of turn rate; 0 is the reference's clock). Logs, trajectories,
+# (ms) and their turn scale against it (%), fitted jointly: heading error = timing x change of turn rate
+# + turn scale x the reference's turn (0 / 0: the reference's clock and turns). Logs, trajectories,
 # traces and plots of each run go to the output directory.
 #
 # usage: scripts/evaluate_all.sh [-e EVALUATE] [-d DATASETS] [-o OUT_DIR] [-p "small medium large"]
@@ -34,8 +35,8 @@ while getopts "e:d:o:p:l:h" option; do
     o) out_dir="$OPTARG" ;;
     p) presets="$OPTARG" ;;
     l) logs="$OPTARG" ;;
-    h) sed -n '2,20p' "$0"; exit 0 ;;
-    *) sed -n '2,20p' "$0" >&2; exit 2 ;;
+    h) sed -n '2,21p' "$0"; exit 0 ;;
+    *) sed -n '2,21p' "$0" >&2; exit 2 ;;
   esac
 done
 shift $((OPTIND - 1))
@@ -73,9 +74,9 @@ echo "runs:     $out_dir/<log>_<preset>.{log,txt,png}"
 [[ ${#extra_args[@]} -gt 0 ]] && echo "extra:    ${extra_args[*]}"
 echo
 
-header=$(printf "%-9s %-6s %5s %8s %19s | %-17s %-17s %-13s %-13s | %-17s %-17s | %5s %5s %6s %11s" \
+header=$(printf "%-9s %-6s %5s %8s %19s | %-17s %-17s %-13s %-13s | %-17s %-17s | %5s %5s %6s %11s %11s" \
   log preset scans fallback "CPU ms med/p99/max" "<=10s laser m/deg" "<=10s wheel" "median l/w m" \
-  "scale l/w" "all laser m/deg" "all wheel" calib leap offset "timing l/w")
+  "scale l/w" "all laser m/deg" "all wheel" calib leap offset "timing l/w" "turns l/w %")
 echo "$header"
 printf '%*s\n' "${#header}" '' | tr ' ' '-'
 
@@ -98,13 +99,13 @@ for log in $logs; do
     fi
     summary="$(grep '^SUMMARY' "$run.log" | tail -n1)"
     field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$summary"; }
-    printf "%-9s %-6s %5s %7s%% %19s | %-17s %-17s %-13s %-13s | %-17s %-17s | %5s %5s %6s %11s\n" "$log" "$preset" \
+    printf "%-9s %-6s %5s %7s%% %19s | %-17s %-17s %-13s %-13s | %-17s %-17s | %5s %5s %6s %11s %11s\n" "$log" "$preset" \
       "$(field scans)" "$(field fallback_pct)" "$(field cpu_median_ms)/$(field cpu_p99_ms)/$(field cpu_max_ms)" \
       "$(field short_t) / $(field short_r)" "$(field wheel_short_t) / $(field wheel_short_r)" \
       "$(field short_t_median)/$(field wheel_short_t_median)" "$(field short_scale)/$(field wheel_short_scale)" \
       "$(field all_t) / $(field all_r)" "$(field wheel_all_t) / $(field wheel_all_r)" \
       "$(printf %.2f "$(field calibration)")" "$(printf %.2f "$(field worst_leap)")" "$(field time_offset)" \
-      "$(field timing_ms)/$(field wheel_timing_ms)"
+      "$(field timing_ms)/$(field wheel_timing_ms)" "$(field turn_scale_pct)/$(field wheel_turn_scale_pct)"
   done
 done
 exit $status

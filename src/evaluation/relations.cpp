@@ -2,6 +2,7 @@
 #include "hglasm_odometry/evaluation/relations.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -176,7 +177,8 @@ TimingFit fitTimingOffset(const std::vector<Relation>& relations, const std::vec
     *rate = normalizeAngle(after - before) / (2.0 * h);
     return true;
   };
-  std::vector<double> changes, errors;
+  std::vector<Eigen::Vector2d> regressors;  // change of turn rate, reference's turn
+  std::vector<double> errors;
   for (std::size_t k = 0; k < relations.size(); ++k) {
     const Relation& relation = relations[k];
     if (!validAt(estimated, valid, k) || !withinSpan(relation, max_span)) continue;
@@ -184,25 +186,33 @@ TimingFit fitTimingOffset(const std::vector<Relation>& relations, const std::vec
     if (!turn_rate(relation.t1, &rate1) || !turn_rate(relation.t2, &rate2)) continue;
     const double error = normalizeAngle(estimated[k].theta - relation.motion.theta);
     if (!(std::abs(error) <= TimingFit::kMaxHeadingError)) continue;
-    changes.push_back(rate2 - rate1);
+    regressors.emplace_back(rate2 - rate1, relation.motion.theta);
     errors.push_back(error);
   }
   TimingFit fit;
-  double xx = 0.0, xy = 0.0;
-  for (std::size_t i = 0; i < changes.size(); ++i) {
-    xx += changes[i] * changes[i];
-    xy += changes[i] * errors[i];
+  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d projection = Eigen::Vector2d::Zero();
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    normal += regressors[i] * regressors[i].transpose();
+    projection += regressors[i] * errors[i];
   }
-  fit.count = static_cast<int>(changes.size());
-  if (fit.count < 2 || !(xx > 0.0)) return fit;
-  fit.offset = xy / xx;
+  fit.count = static_cast<int>(errors.size());
+  // Without turns (or without changes of turn rate) the two cannot be told apart: nothing is fitted.
+  const double det = normal.determinant();
+  if (fit.count < 3 || !(det > 1e-12 * normal(0, 0) * normal(1, 1)) || !(normal(0, 0) > 0.0)) return fit;
+  const Eigen::Matrix2d inverse = normal.inverse();
+  const Eigen::Vector2d estimate = inverse * projection;
+  fit.offset = estimate(0);
+  fit.turn_scale = estimate(1);
   double residual_sq = 0.0;
-  for (std::size_t i = 0; i < changes.size(); ++i) {
-    const double residual = errors[i] - fit.offset * changes[i];
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    const double residual = errors[i] - regressors[i].dot(estimate);
     residual_sq += residual * residual;
   }
-  fit.offset_sd = std::sqrt(residual_sq / (fit.count - 1) / xx);
-  fit.rate_change = std::sqrt(xx / fit.count);
+  const double variance = residual_sq / (fit.count - 2);
+  fit.offset_sd = std::sqrt(variance * inverse(0, 0));
+  fit.turn_scale_sd = std::sqrt(variance * inverse(1, 1));
+  fit.rate_change = std::sqrt(normal(0, 0) / fit.count);
   return fit;
 }
 

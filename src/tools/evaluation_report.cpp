@@ -264,9 +264,12 @@ void printContradicted(std::FILE* out, const char* short_label, const RelationsR
 
 void printTiming(std::FILE* out, const char* short_label, const RelationsReport& report, bool has_wheel) {
   const auto print = [&](const char* name, const hglasm::TimingFit& fit) {
-    std::fprintf(out, "%s %+.0f +- %.0f ms (%d)", name, 1e3 * fit.offset, 1e3 * fit.offset_sd, fit.count);
+    std::fprintf(out, "%s %+.0f +- %.0f ms, turns %+.2f +- %.2f %% (%d)", name, 1e3 * fit.offset,
+                 1e3 * fit.offset_sd, 1e2 * fit.turn_scale, 1e2 * fit.turn_scale_sd, fit.count);
   };
-  std::fprintf(out, "  timing %s: heading error = offset x change of turn rate (wheels'), offset of ",
+  std::fprintf(out,
+               "  timing %s: heading error = offset x change of turn rate (wheels') + turn scale x the "
+               "reference's turn, of ",
                short_label);
   print("laser", report.laser_timing);
   if (has_wheel) print(", wheels", report.wheel_timing);
@@ -342,7 +345,7 @@ void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun
       "laser_frame_short_r=%.3f calibration=%.3f worst_leap=%.3f time_offset=%.3f resets=%d keyframes=%d "
       "short_t_median=%.4f short_r_median=%.3f wheel_short_t_median=%.4f wheel_short_r_median=%.3f "
       "short_scale=%.4f wheel_short_scale=%.4f all_scale=%.4f wheel_all_scale=%.4f timing_ms=%.1f "
-      "wheel_timing_ms=%.1f\n",
+      "wheel_timing_ms=%.1f turn_scale_pct=%.2f wheel_turn_scale_pct=%.2f\n",
       preset.c_str(), scans, run.fallbacks, scans ? 100.0 * run.fallbacks / scans : 0.0, total.median,
       total.p99, total.max, r.laser_all.trans_mean, r.laser_all.rot_mean_deg, r.laser_short.trans_mean,
       r.laser_short.rot_mean_deg, r.wheel_all.trans_mean, r.wheel_all.rot_mean_deg, r.wheel_short.trans_mean,
@@ -351,7 +354,7 @@ void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun
       r.laser_short.trans_median, r.laser_short.rot_median_deg, r.wheel_short.trans_median,
       r.wheel_short.rot_median_deg, r.laser_short.along_track_scale, r.wheel_short.along_track_scale,
       r.laser_all.along_track_scale, r.wheel_all.along_track_scale, 1e3 * r.laser_timing.offset,
-      1e3 * r.wheel_timing.offset);
+      1e3 * r.wheel_timing.offset, 1e2 * r.laser_timing.turn_scale, 1e2 * r.wheel_timing.turn_scale);
 }
 
 }  // namespace hglasm_odometry

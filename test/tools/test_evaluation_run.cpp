@@ -176,8 +176,9 @@ TEST(EvaluationReport, TimesEachEstimateAgainstTheReferencesClockAndJudgesTheRef
   EXPECT_NE(text.find("  timing <= 10 s: heading error = offset x change of turn rate"), std::string::npos)
       << text;
   EXPECT_NE(text.find("  contradicted: 0 relations <= 10 s"), std::string::npos) << text;
-  char timing[64];
-  std::snprintf(timing, sizeof timing, " wheel_timing_ms=%.1f\n", 1e3 * report.wheel_timing.offset);
+  char timing[96];
+  std::snprintf(timing, sizeof timing, " wheel_timing_ms=%.1f turn_scale_pct=%.2f ",
+                1e3 * report.wheel_timing.offset, 1e2 * report.laser_timing.turn_scale);
   EXPECT_NE(text.find(timing), std::string::npos) << text;
 }
 

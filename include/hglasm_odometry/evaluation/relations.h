@@ -57,16 +57,22 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
 void relativeMotions(const std::vector<Relation>& relations, const std::vector<StampedPose>& trajectory,
                      std::vector<Pose2D>* estimated, std::vector<bool>* valid, double stamp_tolerance = 1e-3);
 
-/// Whether an estimate's clock agrees with the reference's. An estimate whose pose at stamp t is the robot's
-/// at t + offset has heading errors offset x (turn rate at t2 - turn rate at t1) over a relation; the offset
-/// is fitted by least squares over the relations spanning at most `max_span` s (<= 0: all). Turn rates come
-/// from `turn_rates` (a trajectory, e.g. the wheels', differenced over +-kTurnRateHalfWindow s).
-/// Relations whose heading error exceeds kMaxHeadingError are left out (a leap is not a timing).
+/// Whether an estimate's clock and its turns agree with the reference's. An estimate whose pose at stamp t
+/// is the robot's at t + offset has heading errors offset x (turn rate at t2 - turn rate at t1) over a
+/// relation; one that counts every turn (1 + turn_scale) times has heading errors turn_scale x the
+/// reference's turn (a laser whose bearings are spread wider than their stated angle increment, wheels
+/// with a wrong wheel base). Both are fitted jointly by least squares over the relations spanning at most
+/// `max_span` s (<= 0: all) — either alone would absorb part of the other, as relations that start or end
+/// in a turn see both. Turn rates come from `turn_rates` (a trajectory, e.g. the wheels', differenced over
+/// +-kTurnRateHalfWindow s). Relations whose heading error exceeds kMaxHeadingError are left out (a leap
+/// is neither).
 struct TimingFit {
-  int count = 0;             ///< relations fitted
-  double offset = 0.0;       ///< seconds; > 0: the estimate's pose at t is the reference's at a later time
-  double offset_sd = 0.0;    ///< its standard error, seconds
-  double rate_change = 0.0;  ///< rad/s: root mean square change of turn rate over the fitted relations
+  int count = 0;               ///< relations fitted
+  double offset = 0.0;         ///< seconds; > 0: the estimate's pose at t is the reference's at a later time
+  double offset_sd = 0.0;      ///< its standard error, seconds
+  double turn_scale = 0.0;     ///< > 0: the estimate turns more than the reference, by this fraction
+  double turn_scale_sd = 0.0;  ///< its standard error
+  double rate_change = 0.0;    ///< rad/s: root mean square change of turn rate over the fitted relations
   static constexpr double kTurnRateHalfWindow = 0.3;  ///< seconds
   static constexpr double kMaxHeadingError = 0.05;    ///< radians (about 3 degrees)
 };
