@@ -197,9 +197,9 @@ TimingFit fitTimingOffset(const std::vector<Relation>& relations, const std::vec
     projection += regressors[i] * errors[i];
   }
   fit.count = static_cast<int>(errors.size());
-  // Without turns (or without changes of turn rate) the two cannot be told apart: nothing is fitted.
-  const double det = normal.determinant();
-  if (fit.count < 3 || !(det > 1e-12 * normal(0, 0) * normal(1, 1)) || !(normal(0, 0) > 0.0)) return fit;
+  // Without turns (or without changes of turn rate) the two cannot be told apart: nothing is fitted. (A
+  // zero diagonal makes the determinant zero too.)
+  if (fit.count < 3 || !(normal.determinant() > 1e-12 * normal(0, 0) * normal(1, 1))) return fit;
   const Eigen::Matrix2d inverse = normal.inverse();
   const Eigen::Vector2d estimate = inverse * projection;
   fit.offset = estimate(0);
