@@ -37,7 +37,6 @@ OdometryPipeline::OdometryPipeline(const TrackerOptions& options, bool wait_for_
 
 bool OdometryPipeline::setLaserMount(const Pose2D& base_to_laser, bool upside_down) {
   if (!base_to_laser.isFinite()) return false;
-  base_to_laser_ = base_to_laser;
   conversion_ = conversionForMount(conversion_, upside_down);
   tracker_.setLaserMount(base_to_laser);
   return true;
@@ -157,8 +156,9 @@ PipelineUpdate OdometryPipeline::processScan(double stamp, const RangeScan& rang
   }
   const TrackerUpdate& result = update.tracker;
   if (result.matched) {
-    // The tracker's own conjugation of the predicted base motion by the mount.
-    update.laser_guess = map_frame.inverse() * result.diagnostics.guess * base_to_laser_;
+    // The tracker's own conjugation of the predicted base motion by the mount (moved by under a millimetre
+    // since, if the lever arm is being learned).
+    update.laser_guess = map_frame.inverse() * result.diagnostics.guess * tracker_.mountInUse();
   }
   if (tracker_.options().prediction.use_imu && result.published && !result.reset) {
     update.imu_stale = !result.diagnostics.rotation_from_imu;

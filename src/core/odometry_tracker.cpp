@@ -40,13 +40,15 @@ OdometryTracker::OdometryTracker(const TrackerOptions& options)
 }
 
 void OdometryTracker::setLaserMount(const Pose2D& base_to_laser) {
-  if (base_to_laser.isFinite()) laser_mount_ = base_to_laser;
+  if (!base_to_laser.isFinite()) return;
+  laser_mount_ = base_to_laser;
+  learner_.setLaserMount(base_to_laser);
 }
 
 void OdometryTracker::reset() {
   initialised_ = false;
   local_map_.clear();
-  pose_ = Pose2D();
+  pose_ = publishedToInternal(Pose2D());  // published at the origin
   pose_covariance_.setZero();
   map_covariance_.setZero();
   extrapolator_.reset();
@@ -60,7 +62,7 @@ void OdometryTracker::reset() {
 bool OdometryTracker::setPose(double stamp, const Pose2D& pose, const Eigen::Matrix3d& covariance) {
   if (!std::isfinite(stamp) || !pose.isFinite() || !isValidPoseCovariance(covariance)) return false;
   reset();
-  pose_ = Pose2D(pose.x, pose.y, normalizeAngle(pose.theta));
+  pose_ = publishedToInternal(Pose2D(pose.x, pose.y, normalizeAngle(pose.theta)));
   pose_covariance_ = symmetricClamped(covariance);
   set_pose_stamp_ = stamp;
   return true;
@@ -118,8 +120,7 @@ bool OdometryTracker::refuse(double stamp, TrackerUpdate* update) const {
   } else {
     update->warning = "scan stamp is not finite; scan ignored";
   }
-  update->pose = pose_;
-  update->pose_covariance = pose_covariance_;
+  publishPose(update);
   return true;
 }
 
@@ -132,7 +133,7 @@ bool OdometryTracker::deskew(double stamp, const Scan& sensor_scan, Scan* compen
       return extrapolator_.imuRotation(from, to, angle);
     };
   }
-  return deskewSweep(sensor_scan, stamp, laser_mount_, motion, compensated);
+  return deskewSweep(sensor_scan, stamp, mountInUse(), motion, compensated);
 }
 
 void OdometryTracker::initialise(double stamp, const Scan& scan, bool usable, TrackerUpdate* update) {
@@ -143,8 +144,7 @@ void OdometryTracker::initialise(double stamp, const Scan& scan, bool usable, Tr
   extrapolator_.addPose(stamp, pose_);
   update->reset = true;
   update->published = true;
-  update->pose = pose_;
-  update->pose_covariance = pose_covariance_;
+  publishPose(update);
   if (usable) addKeyframe(scan, update);
   update->keyframe_id = keyframes_.keyframes();
   update->diagnostics.learned.wheel_noise = learner_.wheelNoise().scale();
@@ -241,6 +241,7 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   learner_.addMatchedScan(prediction, last_stamp_, scanOnlyPose(chosen.match),
                           !update->leap && !verdict.deferred);
   applyLearnedModels();
+  moveMountTowardsLearned();
   return true;
 }
 
@@ -312,6 +313,7 @@ OdometryTracker::Estimate OdometryTracker::integratePrediction(const MotionPredi
 ScanOnlyPose OdometryTracker::scanOnlyPose(const MatchResult& match) const {
   ScanOnlyPose scan_only;
   scan_only.pose = baseInOdometry(match.scan_only_pose);
+  scan_only.laser = local_map_.frame() * match.scan_only_pose;
   scan_only.usable = !match.degenerate && scan_only.pose.isFinite();
   if (!scan_only.usable) return scan_only;
   const Eigen::Matrix3d to_base =
@@ -331,6 +333,12 @@ void OdometryTracker::applyLearnedModels() {
   extrapolator_.setWheelCalibration(learner_.wheelCalibration());
   extrapolator_.setImuBias(learner_.imuBias().bias(), learner_.imuBias().variance());
   matcher_.setScanNoiseScale(learner_.scanNoiseScale());
+}
+
+void OdometryTracker::moveMountTowardsLearned() {
+  const Eigen::Vector2d change = learner_.wheelCalibration().laserOffset() - applied_laser_offset_;
+  const double length = change.norm();
+  if (length > 0.0) applied_laser_offset_ += change * std::min(1.0, kMaxMountChange / length);
 }
 
 void OdometryTracker::advance(double stamp, Estimate estimate, TrackerUpdate* update) {
@@ -386,7 +394,7 @@ void OdometryTracker::addKeyframe(const Scan& scan, TrackerUpdate* update) {
   const bool had_map = !local_map_.empty();
   const Pose2D old_frame = local_map_.frame();
   const auto start = std::chrono::steady_clock::now();
-  local_map_.add(pose_ * laser_mount_, scan.points);
+  local_map_.add(pose_ * mountInUse(), scan.points);
   matcher_.useTables(&local_map_.table(kFineTable), &local_map_.table(kCoarseTable));
   matcher_.extendReference(local_map_.reference(), local_map_.unchangedScans());
   update->diagnostics.table_build_ms = millisecondsSince(start);
@@ -399,15 +407,43 @@ void OdometryTracker::addKeyframe(const Scan& scan, TrackerUpdate* update) {
 
 void OdometryTracker::publish(TrackerUpdate* update) const {
   update->published = true;
-  update->pose = pose_;
-  update->pose_covariance = pose_covariance_;
-  update->velocity = extrapolator_.velocity();
+  publishPose(update);
+  // Twists and increments of the published frame: the wheels' moved by the lever arm d (v + w x d).
+  const Eigen::Vector2d& d = applied_laser_offset_;
+  Eigen::Matrix3d lever = Eigen::Matrix3d::Identity();
+  lever(0, 2) = -d.y();
+  lever(1, 2) = d.x();
+  update->velocity = lever * extrapolator_.velocity();
+  update->velocity_covariance = lever * update->velocity_covariance * lever.transpose();
+  update->increment_covariance = lever * update->increment_covariance * lever.transpose();
   update->keyframe_id = keyframes_.keyframes();
   update->diagnostics.learned = learner_.learned();
 }
 
+Pose2D OdometryTracker::publishedToInternal(const Pose2D& published) const {
+  return published * Pose2D(applied_laser_offset_.x(), applied_laser_offset_.y(), 0.0).inverse();
+}
+
+void OdometryTracker::publishPose(TrackerUpdate* update) const {
+  // Internally the base is the frame the wheels move (the laser at the mount in use); published, it is the
+  // frame tf's stated mount defines, so that the laser's points land where the user's tf puts them.
+  const Eigen::Vector2d& d = applied_laser_offset_;
+  update->pose = pose_ * Pose2D(d.x(), d.y(), 0.0);
+  const double c = std::cos(pose_.theta), s = std::sin(pose_.theta);
+  Eigen::Matrix3d to_published = Eigen::Matrix3d::Identity();
+  to_published(0, 2) = -s * d.x() - c * d.y();
+  to_published(1, 2) = c * d.x() - s * d.y();
+  update->pose_covariance = to_published * pose_covariance_ * to_published.transpose();
+}
+
+Pose2D OdometryTracker::mountInUse() const {
+  return Pose2D(laser_mount_.x + applied_laser_offset_.x(), laser_mount_.y + applied_laser_offset_.y(),
+                laser_mount_.theta);
+}
+
 Pose2D OdometryTracker::laserMotion(const Pose2D& base_motion) const {
-  return laser_mount_.inverse() * base_motion * laser_mount_;
+  const Pose2D mount = mountInUse();
+  return mount.inverse() * base_motion * mount;
 }
 
 Eigen::Matrix3d OdometryTracker::laserMotionCovariance(const MotionPrediction& prediction) const {
@@ -417,11 +453,11 @@ Eigen::Matrix3d OdometryTracker::laserMotionCovariance(const MotionPrediction& p
 }
 
 Pose2D OdometryTracker::laserInMap(const Pose2D& base_pose) const {
-  return local_map_.frame().inverse() * base_pose * laser_mount_;
+  return local_map_.frame().inverse() * base_pose * mountInUse();
 }
 
 Pose2D OdometryTracker::baseInOdometry(const Pose2D& laser_in_map) const {
-  return local_map_.frame() * laser_in_map * laser_mount_.inverse();
+  return local_map_.frame() * laser_in_map * mountInUse().inverse();
 }
 
 }  // namespace hglasm

@@ -28,7 +28,7 @@ NoiseSample SensorLearner::noiseSample(const MotionPrediction& prediction, const
   return sample;
 }
 
-void SensorLearner::learnCalibration(const MotionPrediction& prediction, const Pose2D& scan_motion,
+void SensorLearner::learnCalibration(const MotionPrediction& prediction, const ScanOnlyPose& scan,
                                      const Eigen::Matrix3d& scan_covariance) {
   // The step's innovation variance: the wheels' noise and both scans' (heading; along the track, the
   // larger translation variance of each: the direction of travel is unknown here).
@@ -41,8 +41,10 @@ void SensorLearner::learnCalibration(const MotionPrediction& prediction, const P
   const double larger =
       half_trace + std::hypot(0.5 * (translation(0, 0) - translation(1, 1)), translation(0, 1));
   // An IMU gave the rotation: the wheels' turn says nothing about their heading errors.
-  calibration_.learn(prediction.wheel_motion, scan_motion,
+  calibration_.learn(prediction.wheel_motion, relativePose(scan_pose_, scan.pose),
                      prediction.rotation_from_imu ? -1.0 : heading_variance, larger);
+  calibration_.learnLaserOffset(prediction.wheel_motion, relativePose(scan_laser_, scan.laser), stated_mount_,
+                                translation);
 }
 
 void SensorLearner::addMatchedScan(const MotionPrediction& prediction, double from, const ScanOnlyPose& scan,
@@ -55,7 +57,7 @@ void SensorLearner::addMatchedScan(const MotionPrediction& prediction, double fr
     noise_learner_.add(sample);
     wheel_noise_.setScale(noise_learner_.wheelScale());
     for (const Eigen::Matrix3d& part : sample.scan_covariance) scan_covariance += part;
-    if (have_scan_pose_) learnCalibration(prediction, relativePose(scan_pose_, scan.pose), scan_covariance);
+    if (have_scan_pose_) learnCalibration(prediction, scan, scan_covariance);
   } else {
     noise_learner_.breakChain();
   }
@@ -68,6 +70,7 @@ void SensorLearner::addMatchedScan(const MotionPrediction& prediction, double fr
   have_scan_pose_ = usable;
   have_scan_rotation_ = scan.usable;
   scan_pose_ = scan.pose;
+  scan_laser_ = scan.laser;
 }
 
 void SensorLearner::addUnmatchedScan() { have_scan_pose_ = have_scan_rotation_ = false; }
@@ -98,6 +101,7 @@ LearnedModels SensorLearner::learned() const {
   learned.wheel_turn_scale = calibration_.turnScale();
   learned.wheel_heading_per_metre = calibration_.headingPerMetre();
   learned.wheel_distance_scale = calibration_.distanceScale();
+  learned.laser_offset = calibration_.laserOffset();
   learned.imu_bias = imu_bias_.bias();
   return learned;
 }

@@ -26,6 +26,9 @@ void WheelCalibration::reset() {
           .asDiagonal();
   distance_ = distance_vector_ = 0.0;
   distance_information_ = priorInformation(options_.distance_scale);
+  offset_.setZero();
+  offset_vector_.setZero();
+  offset_information_ = Eigen::Matrix2d::Identity() * priorInformation(options_.laser_offset);
 }
 
 Pose2D WheelCalibration::correct(const Pose2D& wheel_motion) const {
@@ -69,6 +72,36 @@ void WheelCalibration::learn(const Pose2D& wheel_motion, const Pose2D& scan_moti
       distance_ = distance_vector_ / distance_information_;
     }
   }
+}
+
+void WheelCalibration::learnLaserOffset(const Pose2D& wheel_motion, const Pose2D& laser_motion,
+                                        const Pose2D& stated_mount, const Eigen::Matrix2d& covariance) {
+  if (!options_.learn || !(options_.laser_offset > 0.0) || !wheel_motion.isFinite() ||
+      !laser_motion.isFinite() || !stated_mount.isFinite() || !covariance.allFinite()) {
+    return;
+  }
+  const Eigen::Matrix2d information = covariance.inverse();
+  if (!information.allFinite() || !(information.determinant() > 0.0)) return;
+  // The base motion the laser's implies with the stated mount s: R(phi) t_laser + (I - R(turn)) s. The
+  // laser truly at s + d makes it the wheels' + (R(turn) - I) d.
+  const Pose2D scan_base = stated_mount * laser_motion * stated_mount.inverse();
+  const Pose2D wheels = correct(wheel_motion);
+  const Eigen::Vector2d residual(scan_base.x - wheels.x, scan_base.y - wheels.y);
+  const double c = std::cos(wheels.theta), s = std::sin(wheels.theta);
+  Eigen::Matrix2d regressor;
+  regressor << c - 1.0, -s, s, c - 1.0;
+  const Eigen::Vector2d innovation = residual - regressor * offset_;
+  // The innovation's covariance includes what is not yet known of the offset.
+  const Eigen::Matrix2d innovation_covariance =
+      covariance + regressor * offset_information_.inverse() * regressor.transpose();
+  if (innovation.dot(innovation_covariance.inverse() * innovation) > square(kOutlierSigmas)) return;
+  const double forget = std::exp2(-1.0 / std::max(1.0, options_.half_life));
+  offset_information_ =
+      forget * offset_information_ +
+      (1.0 - forget) * Eigen::Matrix2d::Identity() * priorInformation(options_.laser_offset) +
+      regressor.transpose() * information * regressor;
+  offset_vector_ = forget * offset_vector_ + regressor.transpose() * information * residual;
+  offset_ = offset_information_.lu().solve(offset_vector_);
 }
 
 }  // namespace hglasm

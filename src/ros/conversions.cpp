@@ -56,6 +56,8 @@ void setMatchState(const hglasm::TrackerUpdate& update, Match* match) {
   match->prior_mahalanobis = finiteFloat(d.prior_mahalanobis);
   match->noise_scale_xy = finiteFloat(d.learned.wheel_noise.xy);
   match->noise_scale_theta = finiteFloat(d.learned.wheel_noise.theta);
+  match->wheel_turn_scale = finiteFloat(d.learned.wheel_turn_scale);
+  for (int i = 0; i < 2; ++i) match->laser_offset[i] = finiteFloat(d.learned.laser_offset[i]);
   match->degeneracy = finiteFloat(d.degeneracy);
   match->weakest_direction.x = finiteFloat(d.weakest_direction.x());
   match->weakest_direction.y = finiteFloat(d.weakest_direction.y());

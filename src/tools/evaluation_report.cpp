@@ -86,8 +86,9 @@ void printFusion(std::FILE* out, const EvaluationRun& run) {
   std::fprintf(
       out,
       "\nwheels        systematic errors learned: turn scale %+.4f, heading %+.3f deg/m, distance scale "
-      "%+.4f",
-      last.wheel_turn_scale, last.wheel_heading_per_metre * 180.0 / M_PI, last.wheel_distance_scale);
+      "%+.4f; the laser sits (%+.3f, %+.3f) m from its mount",
+      last.wheel_turn_scale, last.wheel_heading_per_metre * 180.0 / M_PI, last.wheel_distance_scale,
+      last.laser_offset.x(), last.laser_offset.y());
 }
 
 /// CPU (and wall) time per stage: median, p99, max and the mean per scan.
@@ -337,6 +338,8 @@ void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun
   const hglasm::Spread total = hglasm::spreadOf(run.total_ms);
   const std::size_t scans = run.processed;
   const RelationsReport& r = report;
+  const hglasm::LearnedModels learned =
+      run.updates.empty() ? hglasm::LearnedModels() : run.updates.back().diagnostics.learned;
   std::fprintf(
       out,
       "SUMMARY preset=%s scans=%zu fallbacks=%d fallback_pct=%.3f cpu_median_ms=%.3f cpu_p99_ms=%.3f "
@@ -345,7 +348,8 @@ void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun
       "laser_frame_short_r=%.3f calibration=%.3f worst_leap=%.3f time_offset=%.3f resets=%d keyframes=%d "
       "short_t_median=%.4f short_r_median=%.3f wheel_short_t_median=%.4f wheel_short_r_median=%.3f "
       "short_scale=%.4f wheel_short_scale=%.4f all_scale=%.4f wheel_all_scale=%.4f timing_ms=%.1f "
-      "wheel_timing_ms=%.1f turn_scale_pct=%.2f wheel_turn_scale_pct=%.2f\n",
+      "wheel_timing_ms=%.1f turn_scale_pct=%.2f wheel_turn_scale_pct=%.2f laser_offset_x=%.4f "
+      "laser_offset_y=%.4f\n",
       preset.c_str(), scans, run.fallbacks, scans ? 100.0 * run.fallbacks / scans : 0.0, total.median,
       total.p99, total.max, r.laser_all.trans_mean, r.laser_all.rot_mean_deg, r.laser_short.trans_mean,
       r.laser_short.rot_mean_deg, r.wheel_all.trans_mean, r.wheel_all.rot_mean_deg, r.wheel_short.trans_mean,
@@ -354,7 +358,8 @@ void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun
       r.laser_short.trans_median, r.laser_short.rot_median_deg, r.wheel_short.trans_median,
       r.wheel_short.rot_median_deg, r.laser_short.along_track_scale, r.wheel_short.along_track_scale,
       r.laser_all.along_track_scale, r.wheel_all.along_track_scale, 1e3 * r.laser_timing.offset,
-      1e3 * r.wheel_timing.offset, 1e2 * r.laser_timing.turn_scale, 1e2 * r.wheel_timing.turn_scale);
+      1e3 * r.wheel_timing.offset, 1e2 * r.laser_timing.turn_scale, 1e2 * r.wheel_timing.turn_scale,
+      learned.laser_offset.x(), learned.laser_offset.y());
 }
 
 }  // namespace hglasm_odometry

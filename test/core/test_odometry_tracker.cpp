@@ -61,9 +61,11 @@ class Robot {
     sim_.setMount(Pose2D());  // these scans always went through the mount, the identity included
   }
 
-  void setMount(const Pose2D& mount) {
-    sim_.setMount(mount);
-    tracker_.setLaserMount(mount);
+  void setMount(const Pose2D& mount) { setMounts(mount, mount); }
+  /// The laser truly at `truth`, tf stating `stated`.
+  void setMounts(const Pose2D& truth, const Pose2D& stated) {
+    sim_.setMount(truth);
+    tracker_.setLaserMount(stated);
   }
 
   /// Wheel odometry with a scale error and a heading drift (integrated from the true motion), that counts
@@ -220,6 +222,66 @@ TEST(OdometryTracker, LaserMountIsAccountedFor) {
   const Pose2D truth = robot.truth(10.0);  // the base, not the laser
   EXPECT_EQ(fallbacks, 0);
   hglasm_test::expectPoseNear(last.pose, truth, 0.03, hglasm_test::deg(0.5), "final pose");
+}
+
+/// Exact wheels on the circle, the laser truly 15 cm ahead of where tf states it (`laser_offset` 0: the
+/// stated mount is taken as exact). Returns the last update; the published frame is tf's (the laser's pose
+/// composed with the stated mount's inverse), from the origin where the tracker started it.
+TrackerUpdate driveWithAWrongMount(double laser_offset, Pose2D* published_truth, Pose2D* mount_in_use,
+                                   double* largest_step_error, double* largest_mount_change = nullptr) {
+  TrackerOptions options;
+  options.learning.wheel_calibration.laser_offset = laser_offset;
+  Robot robot(options, circlePath);
+  const Pose2D stated(0.1, 0.0, 0.0), truth(0.25, 0.0, 0.0);
+  robot.setMounts(truth, stated);
+  robot.enableOdometry(0.0, 0.0);
+  const auto published = [&](double t) { return robot.truth(t) * truth * stated.inverse(); };
+  TrackerUpdate last, previous;
+  *largest_step_error = 0.0;
+  double mount_change = 0.0;
+  for (int i = 0; i <= 250; ++i) {
+    const Pose2D mount_before = robot.tracker().mountInUse();
+    last = robot.step(0.1 * i);
+    mount_change =
+        std::max(mount_change, relativePose(mount_before, robot.tracker().mountInUse()).translationNorm());
+    expectSane(last);
+    EXPECT_FALSE(last.fallback) << "scan " << i;
+    if (i > 0) {
+      // Each published step against the true step of tf's frame.
+      const Pose2D error = relativePose(relativePose(published(0.1 * (i - 1)), published(0.1 * i)),
+                                        relativePose(previous.pose, last.pose));
+      *largest_step_error = std::max(*largest_step_error, error.translationNorm());
+    }
+    previous = last;
+  }
+  *published_truth = published(0.0).inverse() * published(25.0);
+  *mount_in_use = robot.tracker().mountInUse();
+  if (largest_mount_change) *largest_mount_change = mount_change;
+  return last;
+}
+
+TEST(OdometryTracker, LearnsWhereTheLaserSitsWhenTheMountIsWrong) {
+  Pose2D published_truth, mount;
+  double step_error = 0.0, mount_change = 0.0;
+  const TrackerUpdate learned =
+      driveWithAWrongMount(0.1, &published_truth, &mount, &step_error, &mount_change);
+  // The learned place moves up to a centimetre per scan here; the mount in use 1 mm at most, so that
+  // odom -> base_link does not leap.
+  EXPECT_LE(mount_change, 0.001 + 1e-12);
+  EXPECT_LT(step_error, 0.004);
+  EXPECT_NEAR(learned.diagnostics.learned.laser_offset.x(), 0.15, 0.02);
+  EXPECT_NEAR(learned.diagnostics.learned.laser_offset.y(), 0.0, 0.02);
+  hglasm_test::expectPoseNear(mount, Pose2D(0.25, 0.0, 0.0), 0.02, 1e-12, "the mount in use");
+  hglasm_test::expectPoseNear(learned.pose, published_truth, 0.03, hglasm_test::deg(0.5), "learned mount");
+  EXPECT_LT(learned.diagnostics.learned.wheel_noise.xy, 0.01) << "exact wheels are learned as exact";
+  // Taken as exact, the wrong lever arm moves the wheels' motion where the laser's is not: in every turn
+  // the exact wheels look wrong sideways, and are learned as noisy (the fusion then trusts them less).
+  const TrackerUpdate stated = driveWithAWrongMount(0.0, &published_truth, &mount, &step_error);
+  EXPECT_EQ(stated.diagnostics.learned.laser_offset.norm(), 0.0);
+  EXPECT_EQ(mount.x, 0.1);
+  EXPECT_GT(stated.diagnostics.learned.wheel_noise.xy, 0.05);
+  hglasm_test::expectPoseNear(stated.pose, published_truth, 0.03, hglasm_test::deg(0.5), "stated mount");
+  EXPECT_EQ(TrackerOptions().learning.wheel_calibration.laser_offset, 0.0) << "tf's mount by default";
 }
 
 TEST(OdometryTracker, DeskewUndoesTheShearOfASweepTakenWhileMoving) {

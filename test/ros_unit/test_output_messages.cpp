@@ -100,6 +100,8 @@ hglasm::PipelineUpdate matchedUpdate() {
   update.diagnostics.leap_deferred = true;
   update.diagnostics.learned.wheel_noise.xy = 2.0;
   update.diagnostics.learned.wheel_noise.theta = 0.5;
+  update.diagnostics.learned.wheel_turn_scale = -0.0625;
+  update.diagnostics.learned.laser_offset = Eigen::Vector2d(0.0625, -0.125);
   update.diagnostics.odometry_time_offset = 0.125;
   update.diagnostics.odometry_time_offset_estimate = 0.25;
   update.diagnostics.reanchored = true;
@@ -142,6 +144,9 @@ TEST(MatchMsg, AttemptedMatch) {
   EXPECT_TRUE(match.leap_deferred);
   EXPECT_EQ(match.noise_scale_xy, 2.0f);
   EXPECT_EQ(match.noise_scale_theta, 0.5f);
+  EXPECT_EQ(match.wheel_turn_scale, -0.0625f);
+  EXPECT_EQ(match.laser_offset[0], 0.0625f);
+  EXPECT_EQ(match.laser_offset[1], -0.125f);
   EXPECT_EQ(match.odometry_time_offset, 0.125f);
   EXPECT_EQ(match.odometry_time_offset_estimate, 0.25f);
   EXPECT_TRUE(match.reanchored);

@@ -207,6 +207,7 @@ TEST(Parameters, FusionLocalMapAndNoiseParametersAreRead) {
                                   {"odometry/calibration/learn", false},
                                   {"odometry/calibration/turn_scale", 0.2},
                                   {"odometry/calibration/heading_per_metre", 0.01},
+                                  {"odometry/calibration/laser_offset", 0.05},
                                   {"scan_noise/learn", true},
                                   {"scan_noise/directional", false},
                                   {"scan_noise/min_scale", 0.5},
@@ -227,6 +228,7 @@ TEST(Parameters, FusionLocalMapAndNoiseParametersAreRead) {
   EXPECT_FALSE(t.learning.wheel_calibration.learn);
   EXPECT_EQ(t.learning.wheel_calibration.turn_scale, 0.2);
   EXPECT_EQ(t.learning.wheel_calibration.heading_per_metre, 0.01);
+  EXPECT_EQ(t.learning.wheel_calibration.laser_offset, 0.05);
   EXPECT_TRUE(t.learning.noise.learn_scan);
   EXPECT_FALSE(t.learning.noise.directional);
   EXPECT_EQ(t.learning.noise.min_scan_scale, 0.5);

@@ -157,7 +157,6 @@ class OdometryPipeline {
   OdometryTracker tracker_;
   bool wait_for_inputs_;
   ScanConversionOptions conversion_;
-  Pose2D base_to_laser_;
   /// One input the scans wait for (wheel odometry, the IMU) under the time and feeding policies.
   struct InputFeed {
     explicit InputFeed(double reset_on_jump_back) : order(reset_on_jump_back) {}

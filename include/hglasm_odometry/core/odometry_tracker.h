@@ -159,6 +159,11 @@ class OdometryTracker {
   /// base -> laser mounting (after mirroring an upside-down laser). Identity by default.
   void setLaserMount(const Pose2D& base_to_laser);
   const Pose2D& laserMount() const { return laser_mount_; }
+  /// The mount in use: the stated one moved towards the lever arm learned so far (WheelCalibration, with
+  /// odometry/calibration/laser_offset), at most kMaxMountChange per matched scan so that the base's pose
+  /// stays continuous.
+  Pose2D mountInUse() const;
+  static constexpr double kMaxMountChange = 0.001;  // m
 
   /// Wheel odometry: pose of the base in the wheel-odometry frame at `stamp`.
   void addOdometry(double stamp, const Pose2D& odom_pose) { extrapolator_.addOdometry(stamp, odom_pose); }
@@ -239,12 +244,18 @@ class OdometryTracker {
   void learnTimeOffset(double stamp);
   /// Hands what the learner knows to the extrapolator and the matcher.
   void applyLearnedModels();
+  /// Moves the mount in use towards the learned lever arm (once per matched scan, kMaxMountChange at most).
+  void moveMountTowardsLearned();
   /// Moves the estimate on to `estimate` at `stamp`: pose, covariances, velocity.
   void advance(double stamp, Estimate estimate, TrackerUpdate* update);
   void updateVelocity(double stamp, const Pose2D& new_pose, TrackerUpdate* update);
   void updateMap(const Scan& scan, bool usable, TrackerUpdate* update);
   void addKeyframe(const Scan& scan, TrackerUpdate* update);
   void publish(TrackerUpdate* update) const;
+  /// update->pose and pose_covariance: pose_ in the frame tf's stated mount defines.
+  void publishPose(TrackerUpdate* update) const;
+  /// The tracker's pose (the frame the wheels move) of a pose in the published frame.
+  Pose2D publishedToInternal(const Pose2D& published) const;
 
   /// The predicted base motion as the laser makes it (the mount's lever arm), and its covariance.
   Pose2D laserMotion(const Pose2D& base_motion) const;
@@ -261,6 +272,7 @@ class OdometryTracker {
   FitnessMonitor fitness_;
   KeyframePolicy keyframes_;
   Pose2D laser_mount_;
+  Eigen::Vector2d applied_laser_offset_ = Eigen::Vector2d::Zero();  // m, base frame
 
   bool initialised_ = false;
   double last_stamp_ = 0.0;

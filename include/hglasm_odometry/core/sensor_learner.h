@@ -39,7 +39,8 @@ void visitOptions(Visitor& visitor, SensorLearningOptions* options) {
 
 /// Where a matched scan alone put the base.
 struct ScanOnlyPose {
-  Pose2D pose;  ///< the base in the odometry frame
+  Pose2D pose;   ///< the base in the odometry frame
+  Pose2D laser;  ///< the laser in the odometry frame (the same pose before any mount is applied)
   /// The covariance of `pose` that each eigen-direction of the scan's information contributes, weakest
   /// first (NoiseSample::scan_covariance).
   std::array<Eigen::Matrix3d, 3> covariance_parts;
@@ -53,6 +54,7 @@ struct LearnedModels {
   double wheel_turn_scale = 0.0;                       ///< the wheels' systematic errors (WheelCalibration)
   double wheel_heading_per_metre = 0.0;                ///< rad/m
   double wheel_distance_scale = 0.0;
+  Eigen::Vector2d laser_offset = Eigen::Vector2d::Zero();  ///< m: the laser's learned place minus its mount's
   double imu_bias = 0.0;  ///< rad/s: the IMU gyro's bias, subtracted from its rotations
 };
 
@@ -62,6 +64,9 @@ class SensorLearner {
   /// `wheel_noise`: the wheels' noise model whose scales are learned; `imu`: the IMU's, whose bias is.
   SensorLearner(const SensorLearningOptions& options, const MotionNoiseOptions& wheel_noise,
                 const GyroOptions& imu);
+
+  /// base -> laser as stated (tf): the laser's lever arm is learned against it.
+  void setLaserMount(const Pose2D& base_to_laser) { stated_mount_ = base_to_laser; }
 
   /// A matched scan that ends the step `prediction` predicted, which started at `from` (seconds).
   /// `learn_wheels` false: the wheels were wrong beyond their noise (a leap), an outlier rather than noise;
@@ -99,7 +104,7 @@ class SensorLearner {
   /// The learner's sample of a matched scan: where it alone put the base, the wheels' motion since the last.
   NoiseSample noiseSample(const MotionPrediction& prediction, const ScanOnlyPose& scan) const;
   /// The wheels' systematic errors from one step between two matched scans.
-  void learnCalibration(const MotionPrediction& prediction, const Pose2D& scan_motion,
+  void learnCalibration(const MotionPrediction& prediction, const ScanOnlyPose& scan,
                         const Eigen::Matrix3d& scan_covariance);
   void forgetWheelLearning();
 
@@ -109,7 +114,9 @@ class SensorLearner {
   GyroBiasEstimator imu_bias_;
   TimeOffsetEstimator time_offset_;
 
-  Pose2D scan_pose_;  // where the last matched scan alone put the base (odometry frame)
+  Pose2D stated_mount_;
+  Pose2D scan_pose_;   // where the last matched scan alone put the base (odometry frame)
+  Pose2D scan_laser_;  // ... and the laser
   Eigen::Matrix3d scan_covariance_ = Eigen::Matrix3d::Zero();  // ... its covariance (wheel steps only)
   bool have_scan_rotation_ = false;  // scan_pose_ is usable (the IMU's bias learns from it)
   bool have_scan_pose_ = false;      // ... and the wheels predicted that scan (their noise learns from it)

@@ -1,6 +1,7 @@
 // The wheels' systematic errors, learned from the scans: a turn-rate scale (a wrong wheel base), a heading
-// drift per metre travelled (wheels of slightly different size) and a distance scale (a wrong wheel
-// radius). Noise averages out over a log; these add up, and are what makes even good-looking wheels drift.
+// drift per metre travelled (wheels of slightly different size), a distance scale (a wrong wheel radius)
+// and where the laser really sits on the base the wheels turn (a mount off by a lever arm). Noise averages
+// out over a log; these add up, and are what makes even good-looking wheels drift.
 // By default only the turn scale is learned: the scans see rotation well in every turn, while a drift per
 // metre is confounded with their own slow heading error and a distance scale with their bias along
 // corridors (doc/accuracy.md, "Ablation").
@@ -20,6 +21,13 @@ struct WheelCalibrationOptions {
   double turn_scale = 0.1;         ///< fraction of the turn
   double heading_per_metre = 0.0;  ///< rad/m
   double distance_scale = 0.0;     ///< fraction of the distance
+  /// m: how far the laser may sit from where the mount (tf) puts it, in x and y of the base; 0: the mount
+  /// is exact. In every turn the laser's own translation says where it sits relative to the point the
+  /// wheels turn about (a 2-D hand-eye calibration); the tracker then matches with the learned place. A
+  /// wrong lever arm makes scans and wheels disagree sideways in turns, which the fusion turns into a
+  /// heading error; learned only while it is used, since the fusion otherwise hides part of it in the
+  /// heading (doc/accuracy.md, "The laser's lever arm").
+  double laser_offset = 0.0;
 };
 
 /// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
@@ -30,6 +38,7 @@ void visitOptions(Visitor& visitor, WheelCalibrationOptions* options) {
   visitor.nonNegativeNumber("odometry/calibration/turn_scale", &options->turn_scale);
   visitor.nonNegativeNumber("odometry/calibration/heading_per_metre", &options->heading_per_metre);
   visitor.nonNegativeNumber("odometry/calibration/distance_scale", &options->distance_scale);
+  visitor.nonNegativeNumber("odometry/calibration/laser_offset", &options->laser_offset);
 }
 
 /// Recursive least squares on the steps between consecutive matched scans: the heading the scans saw turned
@@ -50,12 +59,21 @@ class WheelCalibration {
   void learn(const Pose2D& wheel_motion, const Pose2D& scan_motion, double heading_variance,
              double distance_variance);
 
+  /// One step seen by the laser: the wheels' raw motion, the laser's own motion, the mount the laser is
+  /// stated at (base -> laser) and the 2 x 2 covariance of the translations' difference in the base frame
+  /// (both noises). Learns where the laser sits: with the stated mount the scans' base motion differs from
+  /// the wheels' by (R(turn) - I) times the mount's error. Steps the model cannot explain are left out.
+  void learnLaserOffset(const Pose2D& wheel_motion, const Pose2D& laser_motion, const Pose2D& stated_mount,
+                        const Eigen::Matrix2d& covariance);
+
   /// Forgets what was learned.
   void reset();
 
   double headingPerMetre() const { return heading_[1]; }
   double turnScale() const { return heading_[0]; }
   double distanceScale() const { return distance_; }
+  /// m, in the base frame: where the laser sits minus where the stated mount puts it.
+  const Eigen::Vector2d& laserOffset() const { return offset_; }
   const WheelCalibrationOptions& options() const { return options_; }
 
  private:
@@ -67,6 +85,9 @@ class WheelCalibration {
   double distance_ = 0.0;
   double distance_information_ = 0.0;
   double distance_vector_ = 0.0;
+  Eigen::Vector2d offset_ = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d offset_information_;
+  Eigen::Vector2d offset_vector_ = Eigen::Vector2d::Zero();
 };
 
 }  // namespace hglasm
