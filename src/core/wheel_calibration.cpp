@@ -87,7 +87,8 @@ void WheelCalibration::learnLaserOffset(const Pose2D& wheel_motion, const Pose2D
   const Pose2D scan_base = stated_mount * laser_motion * stated_mount.inverse();
   const Pose2D wheels = correct(wheel_motion);
   const Eigen::Vector2d residual(scan_base.x - wheels.x, scan_base.y - wheels.y);
-  const double c = std::cos(wheels.theta), s = std::sin(wheels.theta);
+  // The turn as the laser saw it: wheels that slip in turns (or an IMU's rotation) miscount it.
+  const double c = std::cos(laser_motion.theta), s = std::sin(laser_motion.theta);
   Eigen::Matrix2d regressor;
   regressor << c - 1.0, -s, s, c - 1.0;
   const Eigen::Vector2d innovation = residual - regressor * offset_;
