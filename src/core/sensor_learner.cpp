@@ -34,9 +34,13 @@ void SensorLearner::learnCalibration(const MotionPrediction& prediction, const S
   // larger translation variance of each: the direction of travel is unknown here).
   const Eigen::Matrix3d scans = scan_covariance + scan_covariance_;
   const double heading_variance = prediction.covariance(2, 2) + scans(2, 2);
-  // The larger eigenvalue of the 2 x 2 translation block, in closed form.
-  const Eigen::Matrix2d translation =
-      prediction.covariance.topLeftCorner<2, 2>() + scans.topLeftCorner<2, 2>();
+  // The translation block in the base frame where the step starts (the scans' covariances are of the
+  // odometry frame, the prediction's of that base frame), and its larger eigenvalue in closed form.
+  const double c = std::cos(scan_pose_.theta), s = std::sin(scan_pose_.theta);
+  Eigen::Matrix2d to_base;
+  to_base << c, s, -s, c;
+  const Eigen::Matrix2d translation = prediction.covariance.topLeftCorner<2, 2>() +
+                                      to_base * scans.topLeftCorner<2, 2>() * to_base.transpose();
   const double half_trace = 0.5 * (translation(0, 0) + translation(1, 1));
   const double larger =
       half_trace + std::hypot(0.5 * (translation(0, 0) - translation(1, 1)), translation(0, 1));
