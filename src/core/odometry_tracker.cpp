@@ -420,6 +420,10 @@ void OdometryTracker::publish(TrackerUpdate* update) const {
   update->diagnostics.learned = learner_.learned();
 }
 
+Pose2D OdometryTracker::pose() const {
+  return pose_ * Pose2D(applied_laser_offset_.x(), applied_laser_offset_.y(), 0.0);
+}
+
 Pose2D OdometryTracker::publishedToInternal(const Pose2D& published) const {
   return published * Pose2D(applied_laser_offset_.x(), applied_laser_offset_.y(), 0.0).inverse();
 }
@@ -428,7 +432,7 @@ void OdometryTracker::publishPose(TrackerUpdate* update) const {
   // Internally the base is the frame the wheels move (the laser at the mount in use); published, it is the
   // frame tf's stated mount defines, so that the laser's points land where the user's tf puts them.
   const Eigen::Vector2d& d = applied_laser_offset_;
-  update->pose = pose_ * Pose2D(d.x(), d.y(), 0.0);
+  update->pose = pose();
   const double c = std::cos(pose_.theta), s = std::sin(pose_.theta);
   Eigen::Matrix3d to_published = Eigen::Matrix3d::Identity();
   to_published(0, 2) = -s * d.x() - c * d.y();

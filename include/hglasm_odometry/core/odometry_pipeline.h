@@ -142,7 +142,7 @@ class OdometryPipeline {
 
   const TrackerOptions& options() const { return tracker_.options(); }
   const ScanConversionOptions& conversion() const { return conversion_; }
-  const Pose2D& pose() const { return tracker_.pose(); }
+  Pose2D pose() const { return tracker_.pose(); }
   /// The reference scans are matched against: its points in its frame() (the newest keyframe's laser
   /// pose in the odometry frame). revision() tells when it changed.
   const LocalMap& localMap() const { return tracker_.localMap(); }

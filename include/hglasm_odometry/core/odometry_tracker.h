@@ -194,7 +194,8 @@ class OdometryTracker {
   /// (isValidPoseCovariance).
   bool setPose(double stamp, const Pose2D& pose, const Eigen::Matrix3d& covariance);
 
-  const Pose2D& pose() const { return pose_; }
+  /// The base in the odometry frame, as published (the frame tf's stated mount defines).
+  Pose2D pose() const;
   const TrackerOptions& options() const { return options_; }
   int keyframeId() const { return keyframes_.keyframes(); }
   const LocalMap& localMap() const { return local_map_; }
