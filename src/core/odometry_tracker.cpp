@@ -409,10 +409,7 @@ void OdometryTracker::publish(TrackerUpdate* update) const {
   update->published = true;
   publishPose(update);
   // Twists and increments of the published frame: the wheels' moved by the lever arm d (v + w x d).
-  const Eigen::Vector2d& d = applied_laser_offset_;
-  Eigen::Matrix3d lever = Eigen::Matrix3d::Identity();
-  lever(0, 2) = -d.y();
-  lever(1, 2) = d.x();
+  const Eigen::Matrix3d lever = adjoint(leverArm().inverse());
   update->velocity = lever * extrapolator_.velocity();
   update->velocity_covariance = lever * update->velocity_covariance * lever.transpose();
   update->increment_covariance = lever * update->increment_covariance * lever.transpose();
@@ -420,24 +417,21 @@ void OdometryTracker::publish(TrackerUpdate* update) const {
   update->diagnostics.learned = learner_.learned();
 }
 
-Pose2D OdometryTracker::pose() const {
-  return pose_ * Pose2D(applied_laser_offset_.x(), applied_laser_offset_.y(), 0.0);
+Pose2D OdometryTracker::leverArm() const {
+  return Pose2D(applied_laser_offset_.x(), applied_laser_offset_.y(), 0.0);
 }
 
+Pose2D OdometryTracker::pose() const { return pose_ * leverArm(); }
+
 Pose2D OdometryTracker::publishedToInternal(const Pose2D& published) const {
-  return published * Pose2D(applied_laser_offset_.x(), applied_laser_offset_.y(), 0.0).inverse();
+  return published * leverArm().inverse();
 }
 
 void OdometryTracker::publishPose(TrackerUpdate* update) const {
   // Internally the base is the frame the wheels move (the laser at the mount in use); published, it is the
   // frame tf's stated mount defines, so that the laser's points land where the user's tf puts them.
-  const Eigen::Vector2d& d = applied_laser_offset_;
   update->pose = pose();
-  const double c = std::cos(pose_.theta), s = std::sin(pose_.theta);
-  Eigen::Matrix3d to_published = Eigen::Matrix3d::Identity();
-  to_published(0, 2) = -s * d.x() - c * d.y();
-  to_published(1, 2) = c * d.x() - s * d.y();
-  update->pose_covariance = to_published * pose_covariance_ * to_published.transpose();
+  update->pose_covariance = composeCovariance(pose_, pose_covariance_, leverArm(), Eigen::Matrix3d::Zero());
 }
 
 Pose2D OdometryTracker::mountInUse() const {

@@ -257,6 +257,8 @@ class OdometryTracker {
   void publishPose(TrackerUpdate* update) const;
   /// The tracker's pose (the frame the wheels move) of a pose in the published frame.
   Pose2D publishedToInternal(const Pose2D& published) const;
+  /// The published frame in the tracker's: moved by the lever arm applied so far.
+  Pose2D leverArm() const;
 
   /// The predicted base motion as the laser makes it (the mount's lever arm), and its covariance.
   Pose2D laserMotion(const Pose2D& base_motion) const;
