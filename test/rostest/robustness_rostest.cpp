@@ -437,9 +437,17 @@ TEST_F(Robustness, BeamCountAndIncrementChangesNeedNoKeyframeAndNoWarning) {
   // Points are points: after the laser changes, the same local map is matched (no keyframe forced), no
   // fallback, no warning.
   const auto expect_laser_change_handled = [&](const LaserSpec& laser, const std::string& what) {
+    // The local map must hold more than one scan before the change (the test may run first, a few
+    // steps after A started), else a map rebuilt from the new scan alone would look the same.
+    StepResult r;
+    for (int i = 0; i < 50 && r.a.map_keyframes < 2; ++i) {
+      r = step();
+      ASSERT_TRUE(r.ok_a);
+    }
+    ASSERT_GT(r.a.map_keyframes, 1u) << describe(r.a);
     const std::size_t logs_before = w.recorder.logCount();
     w.a->setLaser(laser);
-    StepResult r = step();
+    r = step();
     ASSERT_TRUE(r.ok_a);
     EXPECT_FALSE(r.a.fallback) << describe(r.a);
     EXPECT_GT(r.a.map_keyframes, 1u) << "the map of the earlier scans was kept: " << describe(r.a);
