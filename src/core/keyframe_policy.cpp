@@ -15,11 +15,12 @@ bool KeyframePolicy::wantsKeyframe(const Pose2D& pose, bool matched, bool match_
 
 KeyframeAction KeyframePolicy::decide(const KeyframeCandidate& scan, bool map_empty) {
   if (!scan.usable || scan.leapt) return KeyframeAction::kNone;
+  if (scan.leap_deferred && scan.deferred_leap_fits_as_usual) return KeyframeAction::kNone;
   const bool unexplained = scan.match_failed && !map_empty;
   const bool restart = unexplained && unexplained_scans_ >= 1;
   unexplained_scans_ = unexplained && !restart ? unexplained_scans_ + 1 : 0;
   if (restart) return KeyframeAction::kRestartMap;
-  if (unexplained) return KeyframeAction::kNone;
+  if (unexplained || scan.leap_deferred) return KeyframeAction::kNone;
   const bool wanted = wantsKeyframe(scan.pose, scan.matched, scan.match_failed, scan.fitness_ratio);
   return map_empty || wanted ? KeyframeAction::kAdd : KeyframeAction::kNone;
 }

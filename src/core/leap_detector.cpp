@@ -108,6 +108,7 @@ LeapVerdict LeapDetector::test(const ScanJudge& judge, const LeapHypotheses& h, 
   if (search_wide) {
     verdict.doubted = true;
     const MatchCandidate wide = search_wide();
+    verdict.wide_fitness_ratio = wide.fitness_ratio;
     const double stay_score = tight.acceptable ? stay.best() + judge.freeSpaceLogLikelihood(tight.match.pose)
                                                : predictionLogPosterior(judge, h);
     LogPosteriors leap;

@@ -251,6 +251,7 @@ void OdometryTracker::record(const LeapVerdict& verdict, TrackerUpdate* update) 
   diagnostics.prediction_doubted = verdict.doubted;
   diagnostics.jump_rejected = verdict.rejected;
   diagnostics.leap_deferred = verdict.deferred;
+  diagnostics.deferred_leap_fits_as_usual = verdict.deferred && fitness_.usual(verdict.wide_fitness_ratio);
   diagnostics.leap_probability = verdict.wrong_probability;
   const MatchResult& match = verdict.chosen.match;
   diagnostics.match = match;
@@ -372,7 +373,9 @@ void OdometryTracker::updateMap(const Scan& scan, bool usable, TrackerUpdate* up
   KeyframeCandidate candidate;
   candidate.pose = pose_;
   candidate.usable = usable;
-  candidate.leapt = update->leap || update->diagnostics.leap_deferred;
+  candidate.leapt = update->leap;
+  candidate.leap_deferred = update->diagnostics.leap_deferred;
+  candidate.deferred_leap_fits_as_usual = update->diagnostics.deferred_leap_fits_as_usual;
   candidate.matched = update->matched;
   candidate.match_failed = update->fallback;
   candidate.fitness_ratio = update->diagnostics.fitness_ratio;

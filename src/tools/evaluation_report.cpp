@@ -24,8 +24,11 @@ void worstRelations(const std::vector<hglasm::Relation>& relations,
   for (const auto& error : laser) {
     const auto it = wheel_by_index.find(error.index);
     if (it == wheel_by_index.end()) continue;
-    report->worst_leap_ratio =
-        std::max(report->worst_leap_ratio, error.trans / (3.0 * it->second.trans + 0.10));
+    const double ratio = error.trans / (3.0 * it->second.trans + 0.10);
+    if (ratio <= report->worst_leap_ratio) continue;
+    report->worst_leap_ratio = ratio;
+    const hglasm::Relation& relation = relations[error.index];
+    report->worst_leap = WorstRelation{relation.t1, relation.t2 - relation.t1, error, true, it->second};
   }
   std::sort(laser.begin(), laser.end(), [](const auto& a, const auto& b) { return a.trans > b.trans; });
   for (std::size_t k = 0; k < std::min<std::size_t>(5, laser.size()); ++k) {
@@ -329,8 +332,14 @@ void printRelationsReport(std::FILE* out, const std::string& relations_path,
       std::fprintf(out, "-\n");
     }
   }
-  std::fprintf(out, "  largest laser / (3 x wheel + 0.10 m) over relations <= %g s: %.3f (above 1: a leap)\n",
+  std::fprintf(out, "  largest laser / (3 x wheel + 0.10 m) over relations <= %g s: %.3f (above 1: a leap)",
                report.short_span, report.worst_leap_ratio);
+  const WorstRelation& leap = report.worst_leap;
+  if (report.worst_leap_ratio > 0.0) {
+    std::fprintf(out, ", %.3f +%.2f s: %.4f m | %.4f m", leap.t1, leap.span, leap.laser.trans,
+                 leap.wheel.trans);
+  }
+  std::fprintf(out, "\n");
 }
 
 void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun& run,

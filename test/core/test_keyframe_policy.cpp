@@ -1,6 +1,6 @@
 // Which scans become keyframes: moved or turned past the thresholds since the newest keyframe (measured
 // between the two base poses, angles wrapped), a failed or poor match (another scanner geometry is no
-// reason).
+// reason); which stay out (leaps, taken or waiting) and which restart the map (two unexplained in a row).
 #include "hglasm_odometry/core/keyframe_policy.h"
 
 #include <gtest/gtest.h>
@@ -114,6 +114,35 @@ TEST(KeyframePolicy, OneUnexplainedScanStaysOutTheSecondRestartsTheMap) {
   EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone) << "a restart forgets the first";
   EXPECT_EQ(policy.decide(unexplained, true), KeyframeAction::kAdd) << "an empty map explains nothing";
   EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone) << "and counts afresh";
+}
+
+TEST(KeyframePolicy, AWaitingLeapStaysOutAndCountsAsUnexplainedWhenItFitsNowhereAsUsual) {
+  using hglasm::KeyframeAction;
+  KeyframePolicy policy = policyAt(Pose2D());
+  hglasm::KeyframeCandidate waiting = scanAt(Pose2D(0.6, 0.0, 0.0));  // far enough for a keyframe
+  waiting.leap_deferred = true;
+  EXPECT_EQ(policy.decide(waiting, false), KeyframeAction::kNone) << "it fit near the prediction: it waits";
+  EXPECT_EQ(policy.decide(waiting, false), KeyframeAction::kNone) << "and is not unexplained";
+  waiting.match_failed = true;
+  EXPECT_EQ(policy.decide(waiting, false), KeyframeAction::kNone) << "the first unexplained scan";
+  EXPECT_EQ(policy.decide(waiting, false), KeyframeAction::kRestartMap)
+      << "a second: the map lacks the view, the scan restarts it on the prediction";
+  hglasm::KeyframeCandidate unexplained = scanAt(Pose2D(0.05, 0.0, 0.0));
+  unexplained.match_failed = true;
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone);
+  EXPECT_EQ(policy.decide(waiting, false), KeyframeAction::kRestartMap) << "after an unexplained scan";
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone);
+  hglasm::KeyframeCandidate leapt = unexplained;
+  leapt.leapt = true;
+  EXPECT_EQ(policy.decide(leapt, false), KeyframeAction::kNone) << "a leap taken restarts nothing";
+  // The wheels slipped: the far place fits as usual. The scan waits for the next one's confirmation, and
+  // neither counts nor clears the unexplained scans.
+  hglasm::KeyframeCandidate slipped = waiting;
+  slipped.deferred_leap_fits_as_usual = true;
+  EXPECT_EQ(policy.decide(slipped, false), KeyframeAction::kNone);
+  EXPECT_EQ(policy.decide(slipped, false), KeyframeAction::kNone) << "however many wait";
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kRestartMap)
+      << "the unexplained scan before them still counts";
 }
 
 }  // namespace

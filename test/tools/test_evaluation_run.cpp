@@ -1,6 +1,7 @@
 // evaluate's run and report on bags/fr079_slice.bag: the run is the nodelet's pipeline replayed pose for
 // pose, its counts add up, thinning drops scans and keeps odometry, the wheel baseline and the direct
-// pairs agree with the reference, and the report prints what the run found.
+// pairs agree with the reference, and the report prints what the run found. Regressions on the other
+// slices: intel's lever arm, fr-clinic's turn into a view the map lacks.
 #include "hglasm_odometry/tools/evaluation_run.h"
 
 #include <gtest/gtest.h>
@@ -232,6 +233,37 @@ TEST(EvaluationRun, LearnsWhereIntelsLaserSitsAsTheWholeLogDoes) {
   EXPECT_GT(offset.x(), 0.07);
   EXPECT_LT(offset.x(), 0.14);
   EXPECT_LT(std::abs(offset.y()), 0.02);
+}
+
+TEST(EvaluationRun, FrClinicsTurnIntoAViewTheMapLacksMostlyKeepsTheWheels) {
+  // bags/fr-clinic_turn_slice.bag: near its end (1232660475-481 s) the robot turns 90 degrees into a view
+  // its local map lacks; scans fit it ever worse near the wheels' excellent prediction and some 0.4-0.9 m
+  // away better, and the next scan of the same view asks for the same wrong correction. Over GA seeds 1-10
+  // the previous release leapt there 9 times (largest leap ratio 1.05-1.83, mean 1.56); a deferred leap
+  // that fits nowhere as usual now counts as unexplained and the map restarts on the wheels (4 leaps of
+  // 1.05-1.83, mean 0.76).
+  BagData data;
+  std::vector<hglasm::Relation> relations;
+  std::string error;
+  ASSERT_TRUE(readBag(kSource + "/bags/fr-clinic_turn_slice.bag", BagReadOptions(), &data, &error)) << error;
+  ASSERT_TRUE(hglasm::readRelations(kSource + "/bags/fr-clinic_turn_slice.relations", &relations, &error))
+      << error;
+  LaserOdometryOptions options;
+  ASSERT_TRUE(loadOptions(XmlRpc::XmlRpcValue(), &options, &error)) << error;
+  const std::vector<hglasm::StampedPose> wheel = wheelTrajectory(data);
+  double sum = 0.0;
+  const int seeds = 10;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    options.tracker.matcher.genetic.seed = seed;
+    const RelationsReport report =
+        evaluateRun(relations, runEvaluation(data, options, options.tracker, 0.0), wheel, data, 10.0);
+    ASSERT_GT(report.laser_short.count, 100);
+    std::printf("[measured] seed %d: largest leap ratio %.3f (%.3f +%.2f s: %.3f m, wheels %.3f m)\n", seed,
+                report.worst_leap_ratio, report.worst_leap.t1, report.worst_leap.span,
+                report.worst_leap.laser.trans, report.worst_leap.wheel.trans);
+    sum += report.worst_leap_ratio;
+  }
+  EXPECT_LT(sum / seeds, 1.0) << "the mean over the seeds of the largest laser / (3 x wheels' + 0.10 m)";
 }
 
 }  // namespace

@@ -25,9 +25,13 @@ void visitOptions(Visitor& visitor, KeyframeOptions* options) {
 
 /// A processed scan as the policy sees it.
 struct KeyframeCandidate {
-  Pose2D pose;                 ///< the base's estimated pose
-  bool usable = false;         ///< enough points to be matched (and to be a keyframe)
-  bool leapt = false;          ///< the estimate leapt from the prediction (or a leap was deferred)
+  Pose2D pose;          ///< the base's estimated pose
+  bool usable = false;  ///< enough points to be matched (and to be a keyframe)
+  bool leapt = false;   ///< the estimate leapt from the prediction
+  bool leap_deferred =
+      false;  ///< a leap awaits the next scan's confirmation: the scan stays on the prediction
+  bool deferred_leap_fits_as_usual =
+      false;                   ///< ... to a place where the scan fits the map as scans usually do
   bool matched = false;        ///< a match was attempted
   bool match_failed = false;   ///< no match was accepted: the prediction was integrated
   double fitness_ratio = 0.0;  ///< at the estimated pose
@@ -51,10 +55,14 @@ class KeyframePolicy {
   bool wantsKeyframe(const Pose2D& pose, bool matched, bool match_failed, double fitness_ratio) const;
 
   /// What becomes of `scan` in a local map (empty: `map_empty`). A scan without points to match cannot be a
-  /// keyframe, nor one that leapt (the wheels may be right after all, and a keyframe at the leap would hold
-  /// the map to it). A usable scan the map could not explain is an outlier (someone standing in front of
-  /// the laser) and stays out; a second one in a row says the map no longer describes where the robot is
-  /// (it moved during a pause, the surroundings changed): the map restarts from it. Otherwise
+  /// keyframe, nor one that leapt or whose leap waits (the wheels may be right after all, and a keyframe at
+  /// the leap would hold the map to it). A usable scan the map could not explain is an outlier (someone
+  /// standing in front of the laser) and stays out; a second one in a row says the map no longer describes
+  /// where the robot is (it moved during a pause, the surroundings changed, it turned into a view the map
+  /// lacks): the map restarts from it. A scan whose leap waits counts as unexplained when nothing near the
+  /// prediction fit and the far place does not fit as usual either: a map that lacks the view offers the
+  /// same wrong place to every scan of it, so the next scan would confirm the leap (wheels that slipped
+  /// leave the scan a usual fit at the far place; that leap waits as before). Otherwise
   /// wantsKeyframe(), and always into an empty map.
   KeyframeAction decide(const KeyframeCandidate& scan, bool map_empty);
 

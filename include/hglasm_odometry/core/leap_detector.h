@@ -81,13 +81,14 @@ struct LogPosteriors {
 
 /// What the leap test made of one scan.
 struct LeapVerdict {
-  MatchCandidate chosen;           ///< the tight match, or the wide one if it won (costs of both summed)
-  bool doubted = false;            ///< the prediction was in doubt: the preset's box was searched too
-  bool wide = false;               ///< the wide search's match won
-  bool leapt = false;              ///< ... and lies beyond max_mahalanobis of the prediction
-  bool rejected = false;           ///< a wide match that far lacked the evidence: the prediction held
-  bool deferred = false;           ///< a wide match that far won, but awaits the next scan's confirmation
-  double wrong_probability = 0.0;  ///< posterior probability that the prediction was wrong
+  MatchCandidate chosen;            ///< the tight match, or the wide one if it won (costs of both summed)
+  bool doubted = false;             ///< the prediction was in doubt: the preset's box was searched too
+  bool wide = false;                ///< the wide search's match won
+  bool leapt = false;               ///< ... and lies beyond max_mahalanobis of the prediction
+  bool rejected = false;            ///< a wide match that far lacked the evidence: the prediction held
+  bool deferred = false;            ///< a wide match that far won, but awaits the next scan's confirmation
+  double wrong_probability = 0.0;   ///< posterior probability that the prediction was wrong
+  double wide_fitness_ratio = 0.0;  ///< of the wide search's match (0 if the prediction was not doubted)
   /// The far wide match as a correction of the prediction, taken or deferred: match = correction *
   /// prediction in the odometry frame. Wheels that slipped stay off by the same one: it moves every later
   /// prediction (their increments are right again) onto the truth.

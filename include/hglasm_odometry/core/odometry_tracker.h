@@ -117,6 +117,9 @@ struct TrackerDiagnostics {
   /// A far match won but waits for the next scan to ask for the same correction (LeapOptions::confirm):
   /// the prediction held this time, and the scan is no keyframe.
   bool leap_deferred = false;
+  /// ... and that far match fits the map as scans usually do (the signature of wheels that slipped, where
+  /// a map that lacks the view fits nowhere as usual).
+  bool deferred_leap_fits_as_usual = false;
   double leap_probability = 0.0;  ///< posterior probability that the prediction was wrong
   bool reanchored = false;        ///< the scan did not fit the local map: the map restarted from it
   double table_build_ms = 0.0;    ///< lookup-table build of the new local map (wall ms; 0 if none)

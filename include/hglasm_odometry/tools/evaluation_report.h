@@ -44,6 +44,7 @@ struct RelationsReport {
   hglasm::CalibrationStats calibration;
   std::vector<WorstRelation> worst;  ///< the five largest short errors, largest first
   double worst_leap_ratio = 0.0;     ///< largest laser / (3 x wheel + 0.10 m): above 1 is a leap
+  WorstRelation worst_leap;          ///< the relation with that ratio
 };
 
 /// The metric of `run` (against `wheel_trajectory`, the baseline) over relations up to `short_span` s;
