@@ -220,6 +220,8 @@ TEST(LeapDetector, WheelsRarelyWrongLeapOnlyWhenTheNextScanAsksForTheSameCorrect
   EXPECT_FALSE(first.wide);
   EXPECT_NEAR(first.chosen.match.pose.x, 0.38, 1e-12);
   EXPECT_NEAR(first.correction.x, -0.4, 1e-12) << "match = correction * prediction";
+  EXPECT_EQ(first.wide_fitness_ratio, room.judge().fitnessRatio(Pose2D())) << "the far place's fit";
+  EXPECT_GT(first.wide_fitness_ratio, 0.5);
   detector.remember(first, false);
   // The next asks for the same: the wheels slipped, the leap is taken.
   const LeapVerdict same = slipped(detector, room, 0.4);
