@@ -28,10 +28,10 @@ struct KeyframeCandidate {
   Pose2D pose;          ///< the base's estimated pose
   bool usable = false;  ///< enough points to be matched (and to be a keyframe)
   bool leapt = false;   ///< the estimate leapt from the prediction
-  bool leap_deferred =
-      false;  ///< a leap awaits the next scan's confirmation: the scan stays on the prediction
-  bool deferred_leap_fits_as_usual =
-      false;                   ///< ... to a place where the scan fits the map as scans usually do
+  /// A leap awaits the next scan's confirmation: the scan stays on the prediction...
+  bool leap_deferred = false;
+  /// ... and the far place fits the map as scans usually do (what wheels that slipped leave).
+  bool deferred_leap_fits_as_usual = false;
   bool matched = false;        ///< a match was attempted
   bool match_failed = false;   ///< no match was accepted: the prediction was integrated
   double fitness_ratio = 0.0;  ///< at the estimated pose
