@@ -14,13 +14,23 @@ bool KeyframePolicy::wantsKeyframe(const Pose2D& pose, bool matched, bool match_
 }
 
 KeyframeAction KeyframePolicy::decide(const KeyframeCandidate& scan, bool map_empty) {
+  if (scan.leapt) unconfirmed_leap_ = true;
   if (!scan.usable || scan.leapt) return KeyframeAction::kNone;
   if (scan.leap_deferred && scan.deferred_leap_fits_as_usual) return KeyframeAction::kNone;
   const bool unexplained = scan.match_failed && !map_empty;
   const bool restart = unexplained && unexplained_scans_ >= 1;
   unexplained_scans_ = unexplained && !restart ? unexplained_scans_ + 1 : 0;
-  if (restart) return KeyframeAction::kRestartMap;
+  if (restart) {
+    unconfirmed_leap_ = false;
+    return KeyframeAction::kRestartMap;
+  }
   if (unexplained || scan.leap_deferred) return KeyframeAction::kNone;
+  // A leap is a hypothesis until a scan fits as usual where it put the pose: a keyframe before that would
+  // write a wrong leap into the map, where the next scans would fit it and confirm it.
+  if (unconfirmed_leap_ && !map_empty) {
+    if (!(scan.matched && scan.fits_as_usual)) return KeyframeAction::kNone;
+    unconfirmed_leap_ = false;
+  }
   const bool wanted = wantsKeyframe(scan.pose, scan.matched, scan.match_failed, scan.fitness_ratio);
   return map_empty || wanted ? KeyframeAction::kAdd : KeyframeAction::kNone;
 }

@@ -234,6 +234,7 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   const MatchCandidate& chosen = verdict.chosen;
   if (!chosen.acceptable) return false;
   diagnostics.fitness_ratio = chosen.fitness_ratio;
+  diagnostics.fits_as_usual = fitness_.usual(chosen.fitness_ratio);
   // A scan whose leap waits for confirmation fits poorly where it stays: not a usual fit.
   if (!verdict.deferred) fitness_.add(chosen.fitness_ratio);
   *estimate = estimateFrom(chosen, prior);
@@ -379,6 +380,7 @@ void OdometryTracker::updateMap(const Scan& scan, bool usable, TrackerUpdate* up
   candidate.matched = update->matched;
   candidate.match_failed = update->fallback;
   candidate.fitness_ratio = update->diagnostics.fitness_ratio;
+  candidate.fits_as_usual = update->diagnostics.fits_as_usual;
   switch (keyframes_.decide(candidate, local_map_.empty())) {
     case KeyframeAction::kNone:
       return;

@@ -1,6 +1,7 @@
 // Which scans become keyframes: moved or turned past the thresholds since the newest keyframe (measured
 // between the two base poses, angles wrapped), a failed or poor match (another scanner geometry is no
-// reason); which stay out (leaps, taken or waiting) and which restart the map (two unexplained in a row).
+// reason); which stay out (leaps, taken or waiting, and the scans after a leap until one fits as usual) and
+// which restart the map (two unexplained in a row).
 #include "hglasm_odometry/core/keyframe_policy.h"
 
 #include <gtest/gtest.h>
@@ -143,6 +144,41 @@ TEST(KeyframePolicy, AWaitingLeapStaysOutAndCountsAsUnexplainedWhenItFitsNowhere
   EXPECT_EQ(policy.decide(slipped, false), KeyframeAction::kNone) << "however many wait";
   EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kRestartMap)
       << "the unexplained scan before them still counts";
+}
+
+TEST(KeyframePolicy, AfterALeapNoKeyframeUntilAScanFitsAsUsualWhereItLeapt) {
+  using hglasm::KeyframeAction;
+  KeyframePolicy policy = policyAt(Pose2D());
+  hglasm::KeyframeCandidate leapt = scanAt(Pose2D(0.6, 0.0, 0.0));
+  leapt.leapt = true;
+  EXPECT_EQ(policy.decide(leapt, false), KeyframeAction::kNone);
+  hglasm::KeyframeCandidate poor = scanAt(Pose2D(0.7, 0.0, 0.0));  // far enough for a keyframe
+  poor.fits_as_usual = false;
+  EXPECT_EQ(policy.decide(poor, false), KeyframeAction::kNone) << "the leap may be wrong: not into the map";
+  EXPECT_EQ(policy.decide(poor, false), KeyframeAction::kNone) << "however many";
+  EXPECT_EQ(policy.decide(poor, true), KeyframeAction::kAdd) << "an empty map takes any scan";
+  hglasm::KeyframeCandidate unmatched = scanAt(Pose2D(0.7, 0.0, 0.0));
+  unmatched.matched = false;
+  EXPECT_EQ(policy.decide(unmatched, false), KeyframeAction::kNone) << "no match confirms the leap";
+  EXPECT_EQ(policy.decide(scanAt(Pose2D(0.7, 0.0, 0.0)), false), KeyframeAction::kAdd)
+      << "a scan that fits as usual there confirms it";
+  policy.keyframeAdded(Pose2D(0.7, 0.0, 0.0));
+  poor.pose = Pose2D(1.3, 0.0, 0.0);
+  EXPECT_EQ(policy.decide(poor, false), KeyframeAction::kAdd) << "without a leap, a poor fit is no reason";
+
+  // A restart of the map (two unexplained scans) or of the odometry forgets the leap.
+  EXPECT_EQ(policy.decide(leapt, false), KeyframeAction::kNone);
+  hglasm::KeyframeCandidate unexplained = scanAt(Pose2D(0.05, 0.0, 0.0));
+  unexplained.match_failed = true;
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kNone);
+  EXPECT_EQ(policy.decide(unexplained, false), KeyframeAction::kRestartMap);
+  poor.pose = Pose2D(2.0, 0.0, 0.0);
+  EXPECT_EQ(policy.decide(poor, false), KeyframeAction::kAdd) << "the map restarted";
+  policy.keyframeAdded(poor.pose);
+  EXPECT_EQ(policy.decide(leapt, false), KeyframeAction::kNone);
+  policy.restart();
+  poor.pose = Pose2D(2.6, 0.0, 0.0);
+  EXPECT_EQ(policy.decide(poor, false), KeyframeAction::kAdd) << "the odometry restarted";
 }
 
 }  // namespace

@@ -35,6 +35,7 @@ struct KeyframeCandidate {
   bool matched = false;        ///< a match was attempted
   bool match_failed = false;   ///< no match was accepted: the prediction was integrated
   double fitness_ratio = 0.0;  ///< at the estimated pose
+  bool fits_as_usual = true;   ///< ... as accepted matches usually fit (FitnessMonitor)
 };
 
 /// What becomes of a scan in the local map.
@@ -62,8 +63,10 @@ class KeyframePolicy {
   /// lacks): the map restarts from it. A scan whose leap waits counts as unexplained when nothing near the
   /// prediction fit and the far place does not fit as usual either: a map that lacks the view offers the
   /// same wrong place to every scan of it, so the next scan would confirm the leap (wheels that slipped
-  /// leave the scan a usual fit at the far place; that leap waits as before). Otherwise
-  /// wantsKeyframe(), and always into an empty map.
+  /// leave the scan a usual fit at the far place; that leap waits as before). After a leap no scan becomes a
+  /// keyframe until one fits as usual (`fits_as_usual`) where the leap put the pose: a wrong leap written
+  /// into the map is one the next scans fit and keep. Otherwise wantsKeyframe(), and always into an empty
+  /// map.
   KeyframeAction decide(const KeyframeCandidate& scan, bool map_empty);
 
   /// A keyframe was added with the base at `pose`.
@@ -74,13 +77,17 @@ class KeyframePolicy {
   /// Keyframes added since construction (the newest keyframe's id).
   int keyframes() const { return keyframes_; }
   /// The odometry restarts with an empty map: no scan before counts as unexplained.
-  void restart() { unexplained_scans_ = 0; }
+  void restart() {
+    unexplained_scans_ = 0;
+    unconfirmed_leap_ = false;
+  }
 
  private:
   KeyframeOptions options_;
   Pose2D pose_;  // base pose of the newest keyframe
   int keyframes_ = 0;
-  int unexplained_scans_ = 0;  // usable scans in a row the map could not explain
+  int unexplained_scans_ = 0;      // usable scans in a row the map could not explain
+  bool unconfirmed_leap_ = false;  // a leap was taken and no scan has fit as usual since
 };
 
 }  // namespace hglasm

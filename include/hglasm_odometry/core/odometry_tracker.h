@@ -120,6 +120,9 @@ struct TrackerDiagnostics {
   /// ... and that far match fits the map as scans usually do (the signature of wheels that slipped, where
   /// a map that lacks the view fits nowhere as usual).
   bool deferred_leap_fits_as_usual = false;
+  /// The published pose fits the map as accepted matches usually do (FitnessMonitor, judged before this
+  /// scan's own fit joins it); true when no match was made.
+  bool fits_as_usual = true;
   double leap_probability = 0.0;  ///< posterior probability that the prediction was wrong
   bool reanchored = false;        ///< the scan did not fit the local map: the map restarted from it
   double table_build_ms = 0.0;    ///< lookup-table build of the new local map (wall ms; 0 if none)
