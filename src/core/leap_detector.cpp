@@ -111,8 +111,11 @@ LeapVerdict LeapDetector::test(const ScanJudge& judge, const LeapHypotheses& h, 
     verdict.wide_fitness_ratio = wide.fitness_ratio;
     const double stay_score = tight.acceptable ? stay.best() + judge.freeSpaceLogLikelihood(tight.match.pose)
                                                : predictionLogPosterior(judge, h);
+    // The evidence is a Laplace approximation at the match: a far match whose MbICP was still moving when
+    // it hit its iteration limit is no mode of the posterior, and cannot carry a leap.
+    const bool settled = wide.match.status != MatchStatus::kMbicpNotConverged;
     LogPosteriors leap;
-    if (wide.acceptable) {
+    if (wide.acceptable && (settled || !far(wide))) {
       leap = logPosteriors(judge, h, wide.match);
       leap.add(judge.freeSpaceLogLikelihood(wide.match.pose));
     }

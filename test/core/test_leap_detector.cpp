@@ -174,6 +174,37 @@ TEST(LeapDetector, AWideMatchWithoutTheEvidenceIsRejected) {
   EXPECT_LT(verdict.wrong_probability, 0.5);
 }
 
+TEST(LeapDetector, AFarWideMatchWhoseRefinementDidNotConvergeCannotLeap) {
+  // The wide match of the leap above, but MbICP hit its iteration limit there: no mode of the posterior,
+  // so no evidence to weigh. Near the prediction the same match may still win (it is no leap).
+  const Room room;
+  LeapDetector detector;
+  const LeapHypotheses h = detector.hypotheses(Pose2D(0.4, 0.0, 0.0),
+                                               Eigen::Vector3d(1e-3, 1e-3, 1e-4).asDiagonal(), kBoxVariances);
+  const MatchCandidate tight = candidateAt(Pose2D(0.38, 0.0, 0.0), h, room.judge());
+  MatchCandidate wide = candidateAt(Pose2D(), h, room.judge());
+  wide.match.status = hglasm::MatchStatus::kMbicpNotConverged;
+  ASSERT_TRUE(wide.acceptable);
+  ASSERT_TRUE(detector.far(wide));
+  const LeapVerdict verdict = detector.test(room.judge(), h, true, tight, [&] { return wide; });
+  EXPECT_TRUE(verdict.doubted);
+  EXPECT_FALSE(verdict.wide);
+  EXPECT_FALSE(verdict.leapt);
+  EXPECT_TRUE(verdict.rejected);
+  EXPECT_EQ(verdict.chosen.match.pose.x, 0.38);
+
+  // Within max_mahalanobis of a prediction that fits poorly: the unconverged wide match is no leap and wins.
+  const LeapHypotheses wide_prior =
+      detector.hypotheses(Pose2D(0.4, 0.0, 0.0), Eigen::Vector3d(0.1, 0.1, 0.01).asDiagonal(), kBoxVariances);
+  MatchCandidate near = candidateAt(Pose2D(), wide_prior, room.judge());
+  near.match.status = hglasm::MatchStatus::kMbicpNotConverged;
+  const MatchCandidate poor = candidateAt(Pose2D(0.38, 0.0, 0.0), wide_prior, room.judge());
+  ASSERT_FALSE(detector.far(near));
+  const LeapVerdict near_verdict = detector.test(room.judge(), wide_prior, true, poor, [&] { return near; });
+  EXPECT_TRUE(near_verdict.wide);
+  EXPECT_FALSE(near_verdict.leapt);
+}
+
 TEST(LeapDetector, NothingAcceptableKeepsThePriorOdds) {
   const Room room;
   LeapDetector detector;

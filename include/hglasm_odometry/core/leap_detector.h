@@ -126,7 +126,9 @@ class LeapDetector {
   /// given the prediction was in doubt: it searches the preset's box under the second hypothesis, and the
   /// two matches compete by posterior, with the beams' free space (which the likelihood field leaves out: a
   /// scan occluded by people fits the map better turned onto another corridor, with beams through its
-  /// walls). `informative`: the prior holds information (else no posterior is formed).
+  /// walls). A far wide match whose MbICP hit its iteration limit (kMbicpNotConverged) is no mode of the
+  /// posterior, so its evidence cannot be weighed: it cannot leap. `informative`: the prior holds
+  /// information (else no posterior is formed).
   /// `may_defer`: a far leap may wait for confirmation (LeapOptions::confirm; false for an IMU's rotation).
   LeapVerdict test(const ScanJudge& judge, const LeapHypotheses& h, bool informative,
                    const MatchCandidate& tight, const std::function<MatchCandidate()>& search_wide,
