@@ -46,6 +46,15 @@ MatchCandidate candidateAt(const Pose2D& pose, const LeapHypotheses& h, const hg
   return candidate;
 }
 
+/// Variances of wheels sure of themselves: (x, y, theta).
+const Eigen::Vector3d kConfidentWheels(1e-3, 1e-3, 1e-4);
+
+/// The hypotheses of wheels that put the robot 0.4 m ahead of where it is (the room's origin), with
+/// `variances` of (x, y, theta).
+LeapHypotheses wheelsOff(const LeapDetector& detector, const Eigen::Vector3d& variances) {
+  return detector.hypotheses(Pose2D(0.4, 0.0, 0.0), variances.asDiagonal(), kBoxVariances);
+}
+
 TEST(LeapDetector, TheWrongHypothesisIsWiderAndItsOddsFollowTheLastScan) {
   LeapDetector detector;
   const Eigen::Matrix3d covariance = Eigen::Vector3d(0.01, 0.01, 0.001).asDiagonal();
@@ -136,8 +145,7 @@ TEST(LeapDetector, AWideMatchWithTheEvidenceLeapsAndBothSearchesAreCounted) {
   // The wheels put the robot 0.4 m from where it is: the match near them fits poorly, the wide one fits.
   const Room room;
   LeapDetector detector;
-  const LeapHypotheses h = detector.hypotheses(Pose2D(0.4, 0.0, 0.0),
-                                               Eigen::Vector3d(1e-3, 1e-3, 1e-4).asDiagonal(), kBoxVariances);
+  const LeapHypotheses h = wheelsOff(detector, kConfidentWheels);
   const MatchCandidate tight = candidateAt(Pose2D(0.38, 0.0, 0.0), h, room.judge());
   int searches = 0;
   const LeapVerdict verdict = detector.test(room.judge(), h, true, tight, [&] {
@@ -179,8 +187,7 @@ TEST(LeapDetector, AFarWideMatchWhoseRefinementDidNotConvergeCannotLeap) {
   // so no evidence to weigh. Near the prediction the same match may still win (it is no leap).
   const Room room;
   LeapDetector detector;
-  const LeapHypotheses h = detector.hypotheses(Pose2D(0.4, 0.0, 0.0),
-                                               Eigen::Vector3d(1e-3, 1e-3, 1e-4).asDiagonal(), kBoxVariances);
+  const LeapHypotheses h = wheelsOff(detector, kConfidentWheels);
   const MatchCandidate tight = candidateAt(Pose2D(0.38, 0.0, 0.0), h, room.judge());
   MatchCandidate wide = candidateAt(Pose2D(), h, room.judge());
   wide.match.status = hglasm::MatchStatus::kMbicpNotConverged;
@@ -194,8 +201,7 @@ TEST(LeapDetector, AFarWideMatchWhoseRefinementDidNotConvergeCannotLeap) {
   EXPECT_EQ(verdict.chosen.match.pose.x, 0.38);
 
   // Within max_mahalanobis of a prediction that fits poorly: the unconverged wide match is no leap and wins.
-  const LeapHypotheses wide_prior =
-      detector.hypotheses(Pose2D(0.4, 0.0, 0.0), Eigen::Vector3d(0.1, 0.1, 0.01).asDiagonal(), kBoxVariances);
+  const LeapHypotheses wide_prior = wheelsOff(detector, Eigen::Vector3d(0.1, 0.1, 0.01));
   MatchCandidate near = candidateAt(Pose2D(), wide_prior, room.judge());
   near.match.status = hglasm::MatchStatus::kMbicpNotConverged;
   const MatchCandidate poor = candidateAt(Pose2D(0.38, 0.0, 0.0), wide_prior, room.judge());
@@ -310,8 +316,7 @@ TEST(LeapDetector, AnImusRotationIsCorrectedAtOnce) {
   const Room room;
   const LeapDetector detector = withHistory(5000, 1);
   ASSERT_TRUE(detector.confirmationRequired());
-  const LeapHypotheses h = detector.hypotheses(Pose2D(0.4, 0.0, 0.0),
-                                               Eigen::Vector3d(1e-3, 1e-3, 1e-4).asDiagonal(), kBoxVariances);
+  const LeapHypotheses h = wheelsOff(detector, kConfidentWheels);
   const MatchCandidate tight = candidateAt(Pose2D(0.38, 0.0, 0.0), h, room.judge());
   const LeapVerdict verdict = detector.test(
       room.judge(), h, true, tight, [&] { return candidateAt(Pose2D(), h, room.judge()); }, false);
