@@ -1,5 +1,6 @@
 #include "hglasm_odometry/evaluation/trajectory.h"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -21,6 +22,38 @@ std::vector<StampedPose> trajectoryAt(const OdometryBuffer& odometry, const std:
 std::vector<StampedPose> followedBy(std::vector<StampedPose> trajectory, const Pose2D& offset) {
   for (auto& stamped : trajectory) stamped.pose = stamped.pose * offset;
   return trajectory;
+}
+
+std::vector<StampedPose> blendedWithWheels(const std::vector<StampedPose>& estimate,
+                                           const std::vector<StampedPose>& wheels, double weight_xy,
+                                           double weight_theta) {
+  constexpr double kStampTolerance = 1e-3;
+  // The wheels' pose at each of the estimate's stamps (both sorted by stamp), or none.
+  std::vector<const Pose2D*> wheel_at(estimate.size(), nullptr);
+  std::size_t w = 0;
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    while (w < wheels.size() && wheels[w].stamp < estimate[i].stamp - kStampTolerance) ++w;
+    if (w < wheels.size() && std::abs(wheels[w].stamp - estimate[i].stamp) <= kStampTolerance) {
+      wheel_at[i] = &wheels[w].pose;
+    }
+  }
+  std::vector<StampedPose> blended;
+  blended.reserve(estimate.size());
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    if (i == 0) {
+      blended.push_back(estimate[0]);
+      continue;
+    }
+    Pose2D step = relativePose(estimate[i - 1].pose, estimate[i].pose);
+    if (wheel_at[i - 1] && wheel_at[i]) {
+      const Pose2D wheel_step = relativePose(*wheel_at[i - 1], *wheel_at[i]);
+      step = Pose2D((1.0 - weight_xy) * step.x + weight_xy * wheel_step.x,
+                    (1.0 - weight_xy) * step.y + weight_xy * wheel_step.y,
+                    (1.0 - weight_theta) * step.theta + weight_theta * wheel_step.theta);
+    }
+    blended.push_back({estimate[i].stamp, blended.back().pose * step});
+  }
+  return blended;
 }
 
 std::vector<StampedPose> startedAt(std::vector<StampedPose> trajectory, const Pose2D& start) {

@@ -71,6 +71,9 @@ int evaluate(const EvaluateArguments& args) {
                                                args.direct_pairs ? &options : nullptr);
     printRelationsReport(stdout, args.relations, inputs.relations, report, data.base_frame, !wheel.empty());
     printSummary(stdout, nodelet.preset, run, report);
+    if (args.blend_wheels && !wheel.empty()) {
+      printWheelBlends(stdout, inputs.relations, run.trajectory, wheel, args.short_span);
+    }
   }
   return writeOutputs(args, nodelet.preset, options, data, run, wheel);
 }

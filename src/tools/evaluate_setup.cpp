@@ -45,6 +45,9 @@ const char kUsage[] =
     "                          and the relations those scans and the wheels agree against (> 3 deg off\n"
     "                          the reference's turn, within 1 deg of each other), and the metric\n"
     "                          without them\n"
+    "  --blend-wheels          also score the laser odometry's steps blended with the wheels' at fixed\n"
+    "                          weights (0, 0.25 ... 1 for translation and heading): would any fixed\n"
+    "                          re-weighting of the two inputs serve the relations better than the fusion\n"
     "  --quiet                 no per-warning output\n";
 
 bool exists(const std::string& path) { return std::ifstream(path).good(); }
@@ -88,6 +91,7 @@ ArgumentParser::Result parseEvaluateArguments(const std::vector<std::string>& ar
   parser.addFlag("--no-odom", &args->use_odometry, false);
   parser.addFlag("--quiet", &args->quiet);
   parser.addFlag("--direct-pairs", &args->direct_pairs);
+  parser.addFlag("--blend-wheels", &args->blend_wheels);
   parser.addOption("--max-scans", &args->max_scans);
   parser.addOption("--odom-stamp-shift", &args->odom_stamp_shift);
   parser.addOption("--angle-increment", &args->beam_angles.angle_increment,

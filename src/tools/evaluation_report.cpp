@@ -342,6 +342,27 @@ void printRelationsReport(std::FILE* out, const std::string& relations_path,
   std::fprintf(out, "\n");
 }
 
+void printWheelBlends(std::FILE* out, const std::vector<hglasm::Relation>& relations,
+                      const std::vector<hglasm::StampedPose>& laser,
+                      const std::vector<hglasm::StampedPose>& wheel, double short_span) {
+  std::fprintf(out,
+               "  blends: each step (1 - w) x the laser odometry's + w x the wheels' (w_xy, w_theta 0: the "
+               "laser's)\n");
+  std::fprintf(out, "    w_xy w_theta | <= %.0f s mean m / deg, median m / deg | all relations m / deg\n",
+               short_span);
+  const double weights[] = {0.0, 0.25, 0.5, 0.75, 1.0};
+  for (double weight_xy : weights) {
+    for (double weight_theta : weights) {
+      const auto blended = hglasm::blendedWithWheels(laser, wheel, weight_xy, weight_theta);
+      const hglasm::RelationStats short_stats = hglasm::evaluateRelations(relations, blended, short_span);
+      const hglasm::RelationStats all = hglasm::evaluateRelations(relations, blended, 0.0);
+      std::fprintf(out, "    %4.2f %7.2f | %.4f / %.3f, %.4f / %.3f | %.3f / %.3f\n", weight_xy, weight_theta,
+                   short_stats.trans_mean, short_stats.rot_mean_deg, short_stats.trans_median,
+                   short_stats.rot_median_deg, all.trans_mean, all.rot_mean_deg);
+    }
+  }
+}
+
 void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun& run,
                   const RelationsReport& report) {
   const hglasm::Spread total = hglasm::spreadOf(run.total_ms);

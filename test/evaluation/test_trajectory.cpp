@@ -76,6 +76,41 @@ TEST(Trajectory, StartedAtKeepsTheMotionsAndMovesTheStart) {
   EXPECT_TRUE(startedAt({}, start).empty());
 }
 
+TEST(Trajectory, BlendedWithWheelsWeighsEachStepAndKeepsTheEstimatesWhereTheWheelsAreMissing) {
+  // The estimate drives 1 m per step turning 0.1 rad; the wheels, started elsewhere, 0.8 m turning 0.3 rad.
+  std::vector<StampedPose> estimate, wheels;
+  Pose2D e, w(3.0, -2.0, 1.0);
+  for (int i = 0; i < 4; ++i) {
+    estimate.push_back({10.0 + i, e});
+    if (i != 3) wheels.push_back({10.0 + i + 2e-4, w});  // within the stamp tolerance; none at the last
+    e = e * Pose2D(1.0, 0.0, 0.1);
+    w = w * Pose2D(0.8, 0.0, 0.3);
+  }
+  const auto step = [](const std::vector<StampedPose>& t, int i) {
+    return relativePose(t[i].pose, t[i + 1].pose);
+  };
+  const std::vector<StampedPose> same = blendedWithWheels(estimate, wheels, 0.0, 0.0);
+  const std::vector<StampedPose> half = blendedWithWheels(estimate, wheels, 0.5, 0.25);
+  const std::vector<StampedPose> all = blendedWithWheels(estimate, wheels, 1.0, 1.0);
+  ASSERT_EQ(half.size(), estimate.size());
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(same[i + 1].pose.x, estimate[i + 1].pose.x, 1e-12);
+    EXPECT_NEAR(same[i + 1].pose.theta, estimate[i + 1].pose.theta, 1e-12);
+  }
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(step(half, i).x, 0.9, 1e-12);
+    EXPECT_NEAR(step(half, i).y, 0.0, 1e-12);
+    EXPECT_NEAR(step(half, i).theta, 0.15, 1e-12);
+    EXPECT_NEAR(step(all, i).x, 0.8, 1e-12);
+    EXPECT_NEAR(step(all, i).theta, 0.3, 1e-12);
+  }
+  // The last step has no wheel pose at its end: the estimate's own.
+  EXPECT_NEAR(step(all, 2).x, 1.0, 1e-12);
+  EXPECT_NEAR(step(all, 2).theta, 0.1, 1e-12);
+  EXPECT_NEAR(all[0].pose.x, 0.0, 1e-12);  // starts where the estimate does
+  EXPECT_TRUE(blendedWithWheels({}, wheels, 0.5, 0.5).empty());
+}
+
 TEST(Trajectory, WritesStampPoseAndTheIncrementCovariance) {
   const std::string path = testing::TempDir() + "hglasm_trajectory.txt";
   const std::vector<StampedPose> trajectory = {{1.25, Pose2D(1.0, -2.0, 0.5)},

@@ -20,6 +20,15 @@ std::vector<StampedPose> trajectoryAt(const OdometryBuffer& odometry, const std:
 /// Each pose followed by `offset` (pose * offset): the laser's trajectory from the base's and the mount.
 std::vector<StampedPose> followedBy(std::vector<StampedPose> trajectory, const Pose2D& offset);
 
+/// A trajectory whose step between consecutive poses of `estimate` is the weighted mean of that step and
+/// the step of `wheels` between the same stamps (matched within 1 ms): (1 - weight_xy) times the estimate's
+/// translation plus weight_xy times the wheels', and the same for the heading with weight_theta. Steps the
+/// wheels do not cover keep the estimate's. It starts at the estimate's first pose. With weights 0 it is
+/// `estimate`; with weights 1 it has the wheels' motion at the estimate's stamps.
+std::vector<StampedPose> blendedWithWheels(const std::vector<StampedPose>& estimate,
+                                           const std::vector<StampedPose>& wheels, double weight_xy,
+                                           double weight_theta);
+
 /// `trajectory` moved rigidly so that its first pose is `start`.
 std::vector<StampedPose> startedAt(std::vector<StampedPose> trajectory, const Pose2D& start);
 

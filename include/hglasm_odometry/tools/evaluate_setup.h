@@ -34,6 +34,7 @@ struct EvaluateArguments {
   BeamAngleOverrides beam_angles;
   double short_span = 10.0;
   bool direct_pairs = false;
+  bool blend_wheels = false;
   bool quiet = false;
 };
 

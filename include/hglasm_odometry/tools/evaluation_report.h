@@ -66,6 +66,13 @@ void printRelationsReport(std::FILE* out, const std::string& relations_path,
                           const std::vector<hglasm::Relation>& relations, const RelationsReport& report,
                           const std::string& base_frame, bool has_wheel);
 
+/// --blend-wheels: the metric of the laser odometry's steps blended with the wheels' at fixed weights
+/// (translation, heading: 0, 0.25, 0.5, 0.75, 1 each), one row per pair of weights: whether any fixed
+/// re-weighting of the two inputs' steps would serve the relations better than the fusion's own.
+void printWheelBlends(std::FILE* out, const std::vector<hglasm::Relation>& relations,
+                      const std::vector<hglasm::StampedPose>& laser,
+                      const std::vector<hglasm::StampedPose>& wheel, double short_span);
+
 /// The machine-readable line scripts/evaluate_all.sh reads.
 void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun& run,
                   const RelationsReport& report);
