@@ -23,7 +23,7 @@ ArgumentParser::Result parse(const std::vector<std::string>& arguments, Evaluate
 TEST(EvaluateSetup, ParsesTheCommandLine) {
   EvaluateArguments args;
   ASSERT_EQ(parse({"--bag", "b.bag", "--no-odom", "--laser-mount", "0.1,-0.2,0.3", "--max-scans", "7",
-                   "--angle-min", "-1.5", "--preset", "small", "--max-span", "5"},
+                   "--angle-min", "-1.5", "--preset", "small", "--max-span", "5", "--blend-wheels"},
                   &args),
             ArgumentParser::Result::kOk);
   EXPECT_EQ(args.bag, "b.bag");
@@ -35,6 +35,8 @@ TEST(EvaluateSetup, ParsesTheCommandLine) {
   EXPECT_FALSE(args.beam_angles.angle_increment_given);
   EXPECT_EQ(args.preset, "small");
   EXPECT_EQ(args.short_span, 5.0);
+  EXPECT_TRUE(args.blend_wheels);
+  EXPECT_FALSE(args.direct_pairs);
   EXPECT_FALSE(args.config_given);
 }
 
