@@ -35,8 +35,19 @@ bool validAt(const std::vector<Estimate>& estimates, const std::vector<bool>& va
   return k < estimates.size() && k < valid.size() && valid[k];
 }
 
-/// Index of the trajectory pose whose stamp is nearest to `stamp` if within `tolerance`, else -1.
-/// `trajectory` is sorted by stamp.
+/// The heading of `trajectory` (sorted by stamp) at `stamp`, interpolated between the samples around it.
+bool headingAt(const std::vector<StampedPose>& trajectory, double stamp, double* heading) {
+  const auto after = firstAtOrAfter(trajectory, stamp);
+  if (after == trajectory.begin() || after == trajectory.end()) return false;
+  const StampedPose& a = *std::prev(after);
+  const StampedPose& b = *after;
+  const double fraction = b.stamp > a.stamp ? (stamp - a.stamp) / (b.stamp - a.stamp) : 0.0;
+  *heading = a.pose.theta + fraction * normalizeAngle(b.pose.theta - a.pose.theta);
+  return true;
+}
+
+}  // namespace
+
 long findStamp(const std::vector<StampedPose>& trajectory, double stamp, double tolerance) {
   const auto after = firstAtOrAfter(trajectory, stamp);
   long best = -1;
@@ -52,19 +63,6 @@ long findStamp(const std::vector<StampedPose>& trajectory, double stamp, double 
   }
   return best;
 }
-
-/// The heading of `trajectory` (sorted by stamp) at `stamp`, interpolated between the samples around it.
-bool headingAt(const std::vector<StampedPose>& trajectory, double stamp, double* heading) {
-  const auto after = firstAtOrAfter(trajectory, stamp);
-  if (after == trajectory.begin() || after == trajectory.end()) return false;
-  const StampedPose& a = *std::prev(after);
-  const StampedPose& b = *after;
-  const double fraction = b.stamp > a.stamp ? (stamp - a.stamp) / (b.stamp - a.stamp) : 0.0;
-  *heading = a.pose.theta + fraction * normalizeAngle(b.pose.theta - a.pose.theta);
-  return true;
-}
-
-}  // namespace
 
 bool readRelations(const std::string& path, std::vector<Relation>* relations, std::string* error) {
   std::ifstream file(path);

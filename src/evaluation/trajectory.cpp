@@ -1,10 +1,10 @@
 #include "hglasm_odometry/evaluation/trajectory.h"
 
-#include <cmath>
 #include <cstdio>
 #include <fstream>
 
 #include "hglasm_odometry/evaluation/gnuplot.h"
+#include "hglasm_odometry/evaluation/relations.h"
 
 namespace hglasm {
 
@@ -27,31 +27,23 @@ std::vector<StampedPose> followedBy(std::vector<StampedPose> trajectory, const P
 std::vector<StampedPose> blendedWithWheels(const std::vector<StampedPose>& estimate,
                                            const std::vector<StampedPose>& wheels, double weight_xy,
                                            double weight_theta) {
-  constexpr double kStampTolerance = 1e-3;
-  // The wheels' pose at each of the estimate's stamps (both sorted by stamp), or none.
-  std::vector<const Pose2D*> wheel_at(estimate.size(), nullptr);
-  std::size_t w = 0;
-  for (std::size_t i = 0; i < estimate.size(); ++i) {
-    while (w < wheels.size() && wheels[w].stamp < estimate[i].stamp - kStampTolerance) ++w;
-    if (w < wheels.size() && std::abs(wheels[w].stamp - estimate[i].stamp) <= kStampTolerance) {
-      wheel_at[i] = &wheels[w].pose;
-    }
-  }
+  constexpr double kStampTolerance = 1e-3;  // as the relations match their stamps
   std::vector<StampedPose> blended;
+  if (estimate.empty()) return blended;
   blended.reserve(estimate.size());
-  for (std::size_t i = 0; i < estimate.size(); ++i) {
-    if (i == 0) {
-      blended.push_back(estimate[0]);
-      continue;
-    }
+  blended.push_back(estimate.front());
+  long wheel_before = findStamp(wheels, estimate.front().stamp, kStampTolerance);
+  for (std::size_t i = 1; i < estimate.size(); ++i) {
+    const long wheel_after = findStamp(wheels, estimate[i].stamp, kStampTolerance);
     Pose2D step = relativePose(estimate[i - 1].pose, estimate[i].pose);
-    if (wheel_at[i - 1] && wheel_at[i]) {
-      const Pose2D wheel_step = relativePose(*wheel_at[i - 1], *wheel_at[i]);
+    if (wheel_before >= 0 && wheel_after >= 0) {
+      const Pose2D wheel_step = relativePose(wheels[wheel_before].pose, wheels[wheel_after].pose);
       step = Pose2D((1.0 - weight_xy) * step.x + weight_xy * wheel_step.x,
                     (1.0 - weight_xy) * step.y + weight_xy * wheel_step.y,
                     (1.0 - weight_theta) * step.theta + weight_theta * wheel_step.theta);
     }
     blended.push_back({estimate[i].stamp, blended.back().pose * step});
+    wheel_before = wheel_after;
   }
   return blended;
 }

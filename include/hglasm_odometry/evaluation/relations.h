@@ -39,6 +39,10 @@ struct RelationStats {
   static constexpr double kScaleMinDistance = 0.5;  ///< metres
 };
 
+/// Index of the pose of `trajectory` (sorted by stamp) whose stamp is nearest to `stamp` if within
+/// `tolerance` seconds, else -1.
+long findStamp(const std::vector<StampedPose>& trajectory, double stamp, double tolerance);
+
 /// Evaluates the relations whose span |t2 - t1| is at most `max_span` seconds (<= 0: all) against
 /// `trajectory` (sorted by stamp). A relation's stamps must each match a trajectory stamp within
 /// `stamp_tolerance` seconds, else it counts as missing.
