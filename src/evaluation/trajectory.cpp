@@ -1,5 +1,6 @@
 #include "hglasm_odometry/evaluation/trajectory.h"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -67,6 +68,52 @@ bool writeTrajectory(const std::string& path, const std::vector<StampedPose>& tr
       std::fprintf(file, " %.6g %.6g %.6g %.6g %.6g %.6g", c(0, 0), c(0, 1), c(0, 2), c(1, 1), c(1, 2),
                    c(2, 2));
     }
+    std::fprintf(file, "\n");
+  }
+  return std::fclose(file) == 0;
+}
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+/// Each relation's error under `trajectory`, or none where it lacks one of the relation's stamps.
+std::vector<const RelationError*> errorsByRelation(const std::vector<RelationError>& errors,
+                                                   std::size_t relation_count) {
+  std::vector<const RelationError*> by_relation(relation_count, nullptr);
+  for (const RelationError& error : errors) by_relation[error.index] = &error;
+  return by_relation;
+}
+
+void printRelationError(std::FILE* file, const RelationError* error) {
+  if (!error) {
+    std::fprintf(file, " nan nan nan nan nan");
+    return;
+  }
+  std::fprintf(file, " %.5f %.5f %.4f %.5f %.4f", error->residual.x, error->residual.y,
+               normalizeAngle(error->residual.theta) * kRadToDeg, error->trans, error->rot_deg);
+}
+
+}  // namespace
+
+bool writeRelationErrors(const std::string& path, const std::vector<Relation>& relations,
+                         const std::vector<StampedPose>& laser, const std::vector<StampedPose>& wheels) {
+  std::FILE* file = std::fopen(path.c_str(), "w");
+  if (!file) return false;
+  std::fprintf(file,
+               "# t1 span reference_x reference_y reference_theta_deg laser_dx laser_dy laser_dtheta_deg "
+               "laser_m laser_deg wheel_dx wheel_dy wheel_dtheta_deg wheel_m wheel_deg\n");
+  constexpr double kAllSpans = 0.0;
+  const std::vector<RelationError> laser_errors = relationErrors(relations, laser, kAllSpans);
+  const std::vector<RelationError> wheel_errors = relationErrors(relations, wheels, kAllSpans);
+  const auto laser_by_relation = errorsByRelation(laser_errors, relations.size());
+  const auto wheel_by_relation = errorsByRelation(wheel_errors, relations.size());
+  for (std::size_t k = 0; k < relations.size(); ++k) {
+    const Relation& relation = relations[k];
+    std::fprintf(file, "%.6f %.3f %.5f %.5f %.4f", relation.t1, relation.t2 - relation.t1, relation.motion.x,
+                 relation.motion.y, normalizeAngle(relation.motion.theta) * kRadToDeg);
+    printRelationError(file, laser_by_relation[k]);
+    printRelationError(file, wheel_by_relation[k]);
     std::fprintf(file, "\n");
   }
   return std::fclose(file) == 0;

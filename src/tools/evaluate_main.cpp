@@ -74,6 +74,12 @@ int evaluate(const EvaluateArguments& args) {
     if (args.blend_wheels && !wheel.empty()) {
       printWheelBlends(stdout, inputs.relations, run.trajectory, wheel, args.short_span);
     }
+    if (!args.relation_errors.empty()) {
+      if (!hglasm::writeRelationErrors(args.relation_errors, inputs.relations, run.trajectory, wheel)) {
+        return fail("cannot write " + args.relation_errors, 1);
+      }
+      std::printf("relations     per-relation errors in %s\n", args.relation_errors.c_str());
+    }
   }
   return writeOutputs(args, nodelet.preset, options, data, run, wheel);
 }

@@ -26,6 +26,8 @@ const char kUsage[] =
     "  --out F                 write the trajectory, 'stamp x y theta' per scan (base frame), then the\n"
     "                          increment covariance since the previous scan (xx xy xt yy yt tt)\n"
     "  --trace F               write one line per scan: what the tracker decided and why\n"
+    "  --relation-errors F     write one line per relation (with --relations): the reference's motion and\n"
+    "                          the laser's and the wheels' signed residuals and errors on it\n"
     "  --plot F.png            plot laser and wheel odometry trajectories (gnuplot)\n"
     "  --map F.png             draw every scan at the laser odometry's poses beside the same scans at the\n"
     "                          wheel odometry's (gnuplot; metre grid, equal axis scale)\n"
@@ -86,6 +88,7 @@ ArgumentParser::Result parseEvaluateArguments(const std::vector<std::string>& ar
   parser.addOption("--relations", &args->relations);
   parser.addOption("--out", &args->out);
   parser.addOption("--trace", &args->trace);
+  parser.addOption("--relation-errors", &args->relation_errors);
   parser.addOption("--plot", &args->plot);
   parser.addOption("--map", &args->map);
   parser.addFlag("--no-odom", &args->use_odometry, false);
@@ -107,6 +110,10 @@ ArgumentParser::Result parseEvaluateArguments(const std::vector<std::string>& ar
   if (result != ArgumentParser::Result::kOk) return result;
   if (args->bag.empty()) {
     parser.fail("--bag is required");
+    return ArgumentParser::Result::kError;
+  }
+  if (!args->relation_errors.empty() && args->relations.empty()) {
+    parser.fail("--relation-errors needs --relations");
     return ArgumentParser::Result::kError;
   }
   return ArgumentParser::Result::kOk;

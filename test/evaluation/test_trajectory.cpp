@@ -127,6 +127,44 @@ TEST(Trajectory, WritesStampPoseAndTheIncrementCovariance) {
   EXPECT_FALSE(writeTrajectory("/nonexistent/trajectory.txt", trajectory));
 }
 
+/// The numbers of one line ("nan" read as NaN).
+std::vector<double> numbers(const std::string& line) {
+  std::vector<double> values;
+  std::istringstream in(line);
+  for (std::string field; in >> field;) values.push_back(field == "nan" ? NAN : std::stod(field));
+  return values;
+}
+
+TEST(Trajectory, RelationErrorsGiveEachRelationsSignedResidualsOfBothTrajectories) {
+  const std::string path = testing::TempDir() + "hglasm_relation_errors.txt";
+  const std::vector<Relation> relations = {{0.0, 1.0, Pose2D(1.0, 0.0, 0.0)},
+                                           {0.0, 2.0, Pose2D(2.0, 0.0, 0.1)}};
+  // The laser 0.1 m to the left at 1 s and 0.02 rad over at 2 s; the wheels 0.1 m short and 0.05 rad over
+  // at 1 s, and without a pose at 2 s.
+  const std::vector<StampedPose> laser = {
+      {0.0, Pose2D()}, {1.0, Pose2D(1.0, 0.1, 0.0)}, {2.0, Pose2D(2.0, 0.0, 0.12)}};
+  const std::vector<StampedPose> wheels = {{0.0, Pose2D()}, {1.0, Pose2D(0.9, 0.0, 0.05)}};
+  ASSERT_TRUE(writeRelationErrors(path, relations, laser, wheels));
+  const std::vector<std::string> written = lines(path);
+  ASSERT_EQ(written.size(), 3u);
+  EXPECT_EQ(written[0].substr(0, 12), "# t1 span re");
+  const std::vector<double> first = numbers(written[1]), second = numbers(written[2]);
+  ASSERT_EQ(first.size(), 15u);
+  ASSERT_EQ(second.size(), 15u);
+  const double deg = 180.0 / M_PI;
+  const std::vector<double> expected_first = {0.0,  1.0, 1.0,        0.0, 0.0,          // the relation
+                                              0.0,  0.1, 0.0,        0.1, 0.0,          // the laser
+                                              -0.1, 0.0, 0.05 * deg, 0.1, 0.05 * deg};  // the wheels
+  for (std::size_t i = 0; i < expected_first.size(); ++i) EXPECT_NEAR(first[i], expected_first[i], 1e-4) << i;
+  const std::vector<double> expected_second = {0.0, 2.0, 2.0,        0.0, 0.1 * deg,
+                                               0.0, 0.0, 0.02 * deg, 0.0, 0.02 * deg};
+  for (std::size_t i = 0; i < expected_second.size(); ++i)
+    EXPECT_NEAR(second[i], expected_second[i], 1e-4) << i;
+  for (std::size_t i = 10; i < 15; ++i) EXPECT_TRUE(std::isnan(second[i])) << i;
+  std::remove(path.c_str());
+  EXPECT_FALSE(writeRelationErrors("/nonexistent/errors.txt", relations, laser, wheels));
+}
+
 TEST(Trajectory, TraceHasAHeaderNamingEveryColumnAndALinePerUpdate) {
   const std::string path = testing::TempDir() + "hglasm_trace.txt";
   std::vector<TrackerUpdate> updates(3);

@@ -23,7 +23,8 @@ ArgumentParser::Result parse(const std::vector<std::string>& arguments, Evaluate
 TEST(EvaluateSetup, ParsesTheCommandLine) {
   EvaluateArguments args;
   ASSERT_EQ(parse({"--bag", "b.bag", "--no-odom", "--laser-mount", "0.1,-0.2,0.3", "--max-scans", "7",
-                   "--angle-min", "-1.5", "--preset", "small", "--max-span", "5", "--blend-wheels"},
+                   "--angle-min", "-1.5", "--preset", "small", "--max-span", "5", "--blend-wheels",
+                   "--relations", "r.relations", "--relation-errors", "e.txt"},
                   &args),
             ArgumentParser::Result::kOk);
   EXPECT_EQ(args.bag, "b.bag");
@@ -36,6 +37,7 @@ TEST(EvaluateSetup, ParsesTheCommandLine) {
   EXPECT_EQ(args.preset, "small");
   EXPECT_EQ(args.short_span, 5.0);
   EXPECT_TRUE(args.blend_wheels);
+  EXPECT_EQ(args.relation_errors, "e.txt");
   EXPECT_FALSE(args.direct_pairs);
   EXPECT_FALSE(args.config_given);
 }
@@ -43,6 +45,9 @@ TEST(EvaluateSetup, ParsesTheCommandLine) {
 TEST(EvaluateSetup, RefusesAMissingBagAndABadMount) {
   EvaluateArguments args;
   EXPECT_EQ(parse({"--out", "x.txt"}, &args), ArgumentParser::Result::kError);
+  EvaluateArguments errors_alone;
+  EXPECT_EQ(parse({"--bag", "b.bag", "--relation-errors", "e.txt"}, &errors_alone),
+            ArgumentParser::Result::kError);
   EvaluateArguments mount;
   EXPECT_EQ(parse({"--bag", "b.bag", "--laser-mount", "0.1,0.2"}, &mount), ArgumentParser::Result::kError);
   hglasm::Pose2D pose;

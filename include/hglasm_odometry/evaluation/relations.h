@@ -101,6 +101,7 @@ struct RelationError {
   std::size_t index = 0;  ///< into the relations
   double trans = 0.0;     ///< metres
   double rot_deg = 0.0;   ///< absolute, degrees
+  Pose2D residual;        ///< signed, in the frame of the reference's motion's end
 };
 
 /// Per-relation errors of the relations spanning at most `max_span` s (<= 0: all) whose stamps are in

@@ -9,6 +9,7 @@
 #include "hglasm_odometry/core/odometry_buffer.h"
 #include "hglasm_odometry/core/odometry_tracker.h"
 #include "hglasm_odometry/core/pose2d.h"
+#include "hglasm_odometry/evaluation/relations.h"
 
 namespace hglasm {
 
@@ -36,6 +37,13 @@ std::vector<StampedPose> startedAt(std::vector<StampedPose> trajectory, const Po
 /// motion since the previous pose, in that pose's frame: 'xx xy xtheta yy ytheta thetatheta'.
 bool writeTrajectory(const std::string& path, const std::vector<StampedPose>& trajectory,
                      const std::vector<Eigen::Matrix3d>* increment_covariances = nullptr);
+
+/// One line per relation (the first line names the columns): its stamp, span, reference motion, and the
+/// signed residual (estimated ⊖ reference: x, y in metres, heading in degrees) and absolute errors of
+/// `laser` and of `wheels` on it; "nan" where a trajectory lacks a stamp of the relation. For finding the
+/// relations one estimate loses and the other wins (awk, gnuplot), beside the metric's means.
+bool writeRelationErrors(const std::string& path, const std::vector<Relation>& relations,
+                         const std::vector<StampedPose>& laser, const std::vector<StampedPose>& wheels);
 
 /// One line per scan: what the tracker decided and why (the first line names the columns).
 bool writeTrackerTrace(const std::string& path, const std::vector<TrackerUpdate>& updates);

@@ -25,6 +25,7 @@ struct EvaluateArguments {
   std::string preset;
   std::string relations;
   std::string out, trace, plot, map;
+  std::string relation_errors;  ///< --relation-errors: per-relation errors of both trajectories
   bool use_odometry = true;
   double min_scan_interval = 0.0;
   bool override_mount = false;
