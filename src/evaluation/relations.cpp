@@ -15,8 +15,6 @@ namespace hglasm {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
-
 /// The first pose of `trajectory` (sorted by stamp) stamped at or after `stamp`.
 std::vector<StampedPose>::const_iterator firstAtOrAfter(const std::vector<StampedPose>& trajectory,
                                                         double stamp) {

@@ -75,8 +75,6 @@ bool writeTrajectory(const std::string& path, const std::vector<StampedPose>& tr
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
-
 /// Each relation's error under `trajectory`, or none where it lacks one of the relation's stamps.
 std::vector<const RelationError*> errorsByRelation(const std::vector<RelationError>& errors,
                                                    std::size_t relation_count) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -9,6 +10,9 @@
 #include "hglasm_odometry/core/pose2d.h"
 
 namespace hglasm {
+
+/// The metric reports rotations in degrees.
+inline constexpr double kRadToDeg = 180.0 / M_PI;
 
 /// Pose of the robot at t2 expressed in the robot frame at t1.
 struct Relation {
