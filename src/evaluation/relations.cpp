@@ -242,8 +242,7 @@ std::vector<RelationError> relationErrors(const std::vector<Relation>& relations
     if (i1 < 0 || i2 < 0) continue;
     const Pose2D residual =
         relativePose(relation.motion, relativePose(trajectory[i1].pose, trajectory[i2].pose));
-    errors.push_back(
-        {k, residual.translationNorm(), std::abs(normalizeAngle(residual.theta)) * kRadToDeg, residual});
+    errors.push_back({k, residual});
   }
   return errors;
 }

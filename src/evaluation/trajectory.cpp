@@ -89,7 +89,7 @@ void printRelationError(std::FILE* file, const RelationError* error) {
     return;
   }
   std::fprintf(file, " %.5f %.5f %.4f %.5f %.4f", error->residual.x, error->residual.y,
-               normalizeAngle(error->residual.theta) * kRadToDeg, error->trans, error->rot_deg);
+               normalizeAngle(error->residual.theta) * kRadToDeg, error->trans(), error->rotDeg());
 }
 
 }  // namespace

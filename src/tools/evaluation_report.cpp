@@ -24,13 +24,13 @@ void worstRelations(const std::vector<hglasm::Relation>& relations,
   for (const auto& error : laser) {
     const auto it = wheel_by_index.find(error.index);
     if (it == wheel_by_index.end()) continue;
-    const double ratio = error.trans / (3.0 * it->second.trans + 0.10);
+    const double ratio = error.trans() / (3.0 * it->second.trans() + 0.10);
     if (ratio <= report->worst_leap_ratio) continue;
     report->worst_leap_ratio = ratio;
     const hglasm::Relation& relation = relations[error.index];
     report->worst_leap = WorstRelation{relation.t1, relation.t2 - relation.t1, error, true, it->second};
   }
-  std::sort(laser.begin(), laser.end(), [](const auto& a, const auto& b) { return a.trans > b.trans; });
+  std::sort(laser.begin(), laser.end(), [](const auto& a, const auto& b) { return a.trans() > b.trans(); });
   for (std::size_t k = 0; k < std::min<std::size_t>(5, laser.size()); ++k) {
     WorstRelation worst;
     const hglasm::Relation& relation = relations[laser[k].index];
@@ -324,10 +324,10 @@ void printRelationsReport(std::FILE* out, const std::string& relations_path,
   std::fprintf(out, "  worst relations <= %g s (t1, span; laser m / deg | wheel m / deg):\n",
                report.short_span);
   for (const WorstRelation& worst : report.worst) {
-    std::fprintf(out, "    %.3f +%.2f s  %.4f / %6.3f | ", worst.t1, worst.span, worst.laser.trans,
-                 worst.laser.rot_deg);
+    std::fprintf(out, "    %.3f +%.2f s  %.4f / %6.3f | ", worst.t1, worst.span, worst.laser.trans(),
+                 worst.laser.rotDeg());
     if (worst.has_wheel) {
-      std::fprintf(out, "%.4f / %6.3f\n", worst.wheel.trans, worst.wheel.rot_deg);
+      std::fprintf(out, "%.4f / %6.3f\n", worst.wheel.trans(), worst.wheel.rotDeg());
     } else {
       std::fprintf(out, "-\n");
     }
@@ -336,8 +336,8 @@ void printRelationsReport(std::FILE* out, const std::string& relations_path,
                report.short_span, report.worst_leap_ratio);
   const WorstRelation& leap = report.worst_leap;
   if (report.worst_leap_ratio > 0.0) {
-    std::fprintf(out, ", %.3f +%.2f s: %.4f m | %.4f m", leap.t1, leap.span, leap.laser.trans,
-                 leap.wheel.trans);
+    std::fprintf(out, ", %.3f +%.2f s: %.4f m | %.4f m", leap.t1, leap.span, leap.laser.trans(),
+                 leap.wheel.trans());
   }
   std::fprintf(out, "\n");
 }

@@ -302,9 +302,9 @@ TEST(Relations, PerRelationErrorsInTheOrderOfTheRelations) {
   const std::vector<RelationError> errors = relationErrors(relations, trajectory, 10.0);
   ASSERT_EQ(errors.size(), 2u);
   EXPECT_EQ(errors[0].index, 0u);
-  EXPECT_NEAR(errors[0].trans, 0.0, 1e-12);
+  EXPECT_NEAR(errors[0].trans(), 0.0, 1e-12);
   EXPECT_EQ(errors[1].index, 1u);
-  EXPECT_NEAR(errors[1].trans, 0.1, 1e-12);
+  EXPECT_NEAR(errors[1].trans(), 0.1, 1e-12);
 }
 
 /// A robot driving at 0.5 m/s whose turn rate swings as 0.5 sin(0.3 t) rad/s, its pose at time t (exact).

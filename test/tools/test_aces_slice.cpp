@@ -53,7 +53,7 @@ Accuracy replay(bool fusion) {
   EXPECT_TRUE(hglasm::readRelations(kRelations, &relations, &error)) << error;
   accuracy.stats = hglasm::evaluateRelations(relations, trajectory, 0.0);
   for (const auto& relation_error : hglasm::relationErrors(relations, trajectory, 0.0)) {
-    accuracy.largest = std::max(accuracy.largest, relation_error.trans);
+    accuracy.largest = std::max(accuracy.largest, relation_error.trans());
   }
   return accuracy;
 }

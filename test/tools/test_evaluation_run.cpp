@@ -137,7 +137,7 @@ TEST(EvaluationReport, PrintsTheMetricAndTheSummaryOfTheRun) {
   EXPECT_TRUE(report.laser_frame);  // fr079's laser is 4 cm ahead of the base
   EXPECT_FALSE(report.has_direct_pairs);
   ASSERT_EQ(report.worst.size(), 5u);
-  EXPECT_GE(report.worst[0].laser.trans, report.worst[4].laser.trans);
+  EXPECT_GE(report.worst[0].laser.trans(), report.worst[4].laser.trans());
   EXPECT_LT(report.laser_short.trans_mean, report.wheel_short.trans_mean * 2.0);
 
   const std::string text = printed([&](std::FILE* out) {
@@ -260,7 +260,7 @@ TEST(EvaluationRun, FrClinicsTurnIntoAViewTheMapLacksMostlyKeepsTheWheels) {
     ASSERT_GT(report.laser_short.count, 100);
     std::printf("[measured] seed %d: largest leap ratio %.3f (%.3f +%.2f s: %.3f m, wheels %.3f m)\n", seed,
                 report.worst_leap_ratio, report.worst_leap.t1, report.worst_leap.span,
-                report.worst_leap.laser.trans, report.worst_leap.wheel.trans);
+                report.worst_leap.laser.trans(), report.worst_leap.wheel.trans());
     sum += report.worst_leap_ratio;
   }
   EXPECT_LT(sum / seeds, 1.0) << "the mean over the seeds of the largest laser / (3 x wheels' + 0.10 m)";

@@ -103,9 +103,11 @@ std::vector<bool> contradictedRelations(const std::vector<Relation>& relations,
 /// One relation's error (the residual estimated ⊖ reference).
 struct RelationError {
   std::size_t index = 0;  ///< into the relations
-  double trans = 0.0;     ///< metres
-  double rot_deg = 0.0;   ///< absolute, degrees
   Pose2D residual;        ///< signed, in the frame of the reference's motion's end
+  /// Metres.
+  double trans() const { return residual.translationNorm(); }
+  /// Absolute, degrees.
+  double rotDeg() const { return std::abs(normalizeAngle(residual.theta)) * kRadToDeg; }
 };
 
 /// Per-relation errors of the relations spanning at most `max_span` s (<= 0: all) whose stamps are in
