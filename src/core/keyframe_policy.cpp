@@ -13,6 +13,13 @@ bool KeyframePolicy::wantsKeyframe(const Pose2D& pose, bool matched, bool match_
          std::abs(since_keyframe.theta) > options_.angle || (matched && fitness_ratio < options_.min_fitness);
 }
 
+bool KeyframePolicy::waitsForSlowerTurn(const KeyframeCandidate& scan) const {
+  if (!(options_.max_turn_rate > 0.0) || !(std::abs(scan.turn_rate) > options_.max_turn_rate)) return false;
+  // Only while the map still explains the scan as usual: once it does not, the view is needed.
+  return scan.matched && !scan.match_failed && scan.fits_as_usual &&
+         scan.fitness_ratio >= options_.min_fitness;
+}
+
 KeyframeAction KeyframePolicy::decide(const KeyframeCandidate& scan, bool map_empty) {
   if (scan.leapt) unconfirmed_leap_ = true;
   if (!scan.usable || scan.leapt) return KeyframeAction::kNone;
@@ -32,7 +39,8 @@ KeyframeAction KeyframePolicy::decide(const KeyframeCandidate& scan, bool map_em
     unconfirmed_leap_ = false;
   }
   const bool wanted = wantsKeyframe(scan.pose, scan.matched, scan.match_failed, scan.fitness_ratio);
-  return map_empty || wanted ? KeyframeAction::kAdd : KeyframeAction::kNone;
+  if (map_empty) return KeyframeAction::kAdd;
+  return wanted && !waitsForSlowerTurn(scan) ? KeyframeAction::kAdd : KeyframeAction::kNone;
 }
 
 }  // namespace hglasm

@@ -381,6 +381,7 @@ void OdometryTracker::updateMap(const Scan& scan, bool usable, TrackerUpdate* up
   candidate.match_failed = update->fallback;
   candidate.fitness_ratio = update->diagnostics.fitness_ratio;
   candidate.fits_as_usual = update->diagnostics.fits_as_usual;
+  candidate.turn_rate = extrapolator_.velocity().z();
   switch (keyframes_.decide(candidate, local_map_.empty())) {
     case KeyframeAction::kNone:
       return;

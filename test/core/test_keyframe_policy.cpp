@@ -181,4 +181,37 @@ TEST(KeyframePolicy, AfterALeapNoKeyframeUntilAScanFitsAsUsualWhereItLeapt) {
   EXPECT_EQ(policy.decide(poor, false), KeyframeAction::kAdd) << "the odometry restarted";
 }
 
+TEST(KeyframePolicy, ADueKeyframeWaitsForASlowerTurnWhileTheMapExplainsTheScan) {
+  using hglasm::KeyframeAction;
+  hglasm::KeyframeOptions options;
+  options.angle = kAngle;
+  options.max_turn_rate = 0.5;
+  KeyframePolicy policy(options);
+  policy.keyframeAdded(Pose2D());
+  hglasm::KeyframeCandidate turning = scanAt(Pose2D(0.0, 0.0, 0.3));  // past the angle: due
+  turning.turn_rate = -0.6;
+  EXPECT_EQ(policy.decide(turning, false), KeyframeAction::kNone) << "turning faster than 0.5 rad/s";
+  turning.pose.theta = 1.5;
+  EXPECT_EQ(policy.decide(turning, false), KeyframeAction::kNone) << "however far it turned, while it fits";
+  hglasm::KeyframeCandidate lost = turning;
+  lost.fits_as_usual = false;
+  EXPECT_EQ(policy.decide(lost, false), KeyframeAction::kAdd)
+      << "the map no longer explains it: the view is needed";
+  turning.turn_rate = 0.5;
+  EXPECT_EQ(policy.decide(turning, false), KeyframeAction::kAdd) << "not faster than the limit";
+  turning.turn_rate = 0.6;
+  EXPECT_EQ(policy.decide(turning, true), KeyframeAction::kAdd) << "an empty map takes any scan";
+  turning.pose.theta = 0.1;
+  turning.turn_rate = 0.0;
+  EXPECT_EQ(policy.decide(turning, false), KeyframeAction::kNone)
+      << "a slow scan that is not due waits anyway";
+
+  options.max_turn_rate = 0.0;  // the default: never waits
+  KeyframePolicy never(options);
+  never.keyframeAdded(Pose2D());
+  hglasm::KeyframeCandidate fast = scanAt(Pose2D(0.0, 0.0, 0.3));
+  fast.turn_rate = 3.0;
+  EXPECT_EQ(never.decide(fast, false), KeyframeAction::kAdd);
+}
+
 }  // namespace

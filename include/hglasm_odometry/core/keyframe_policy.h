@@ -13,6 +13,11 @@ struct KeyframeOptions {
   double distance = 0.50;    ///< metres moved since the keyframe that make a new keyframe
   double angle = 0.20;       ///< radians turned since the keyframe that make a new keyframe
   double min_fitness = 0.0;  ///< a published pose below this fitness ratio makes the scan a keyframe
+  /// Rad/s: a due keyframe waits for a scan taken turning slower than this, while the map still explains
+  /// the scans as usual (0: never waits). Keyframes chained through a turn pass each match's heading
+  /// error on to the next; with fewer of them the map's heading drifts less, but sparse scans (one per
+  /// quarter radian of a turn) can lose the view they need (doc/accuracy.md "Keyframes in turns").
+  double max_turn_rate = 0.0;
 };
 
 /// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
@@ -21,6 +26,7 @@ void visitOptions(Visitor& visitor, KeyframeOptions* options) {
   visitor.positiveNumber("keyframe/distance", &options->distance);
   visitor.number("keyframe/angle", &options->angle, 0.0, M_PI, true);
   visitor.fraction("keyframe/min_fitness", &options->min_fitness);
+  visitor.nonNegativeNumber("keyframe/max_turn_rate", &options->max_turn_rate);
 }
 
 /// A processed scan as the policy sees it.
@@ -36,6 +42,7 @@ struct KeyframeCandidate {
   bool match_failed = false;   ///< no match was accepted: the prediction was integrated
   double fitness_ratio = 0.0;  ///< at the estimated pose
   bool fits_as_usual = true;   ///< ... as accepted matches usually fit (FitnessMonitor)
+  double turn_rate = 0.0;      ///< rad/s of the base at the scan (its recent poses)
 };
 
 /// What becomes of a scan in the local map.
@@ -83,6 +90,9 @@ class KeyframePolicy {
   }
 
  private:
+  /// A due keyframe waits: `scan` turns faster than max_turn_rate while the map still explains it.
+  bool waitsForSlowerTurn(const KeyframeCandidate& scan) const;
+
   KeyframeOptions options_;
   Pose2D pose_;  // base pose of the newest keyframe
   int keyframes_ = 0;
