@@ -1,7 +1,8 @@
 // Which scans become keyframes: moved or turned past the thresholds since the newest keyframe (measured
 // between the two base poses, angles wrapped), a failed or poor match (another scanner geometry is no
-// reason); which stay out (leaps, taken or waiting, and the scans after a leap until one fits as usual) and
-// which restart the map (two unexplained in a row).
+// reason); which stay out (leaps, taken or waiting, the scans after a leap until one fits as usual, and with
+// keyframe/max_turn_rate due scans that turn fast while they fit) and which restart the map (two unexplained
+// in a row).
 #include "hglasm_odometry/core/keyframe_policy.h"
 
 #include <gtest/gtest.h>

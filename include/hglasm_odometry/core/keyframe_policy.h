@@ -72,8 +72,9 @@ class KeyframePolicy {
   /// same wrong place to every scan of it, so the next scan would confirm the leap (wheels that slipped
   /// leave the scan a usual fit at the far place; that leap waits as before). After a leap no scan becomes a
   /// keyframe until one fits as usual (`fits_as_usual`) where the leap put the pose: a wrong leap written
-  /// into the map is one the next scans fit and keep. Otherwise wantsKeyframe(), and always into an empty
-  /// map.
+  /// into the map is one the next scans fit and keep. Otherwise wantsKeyframe(), unless the base turns
+  /// faster than max_turn_rate while the scan fits as usual (the keyframe waits for a slower scan), and
+  /// always into an empty map.
   KeyframeAction decide(const KeyframeCandidate& scan, bool map_empty);
 
   /// A keyframe was added with the base at `pose`.
