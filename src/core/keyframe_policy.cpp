@@ -15,9 +15,9 @@ bool KeyframePolicy::wantsKeyframe(const Pose2D& pose, bool matched, bool match_
 
 bool KeyframePolicy::waitsForSlowerTurn(const KeyframeCandidate& scan) const {
   if (!(options_.max_turn_rate > 0.0) || !(std::abs(scan.turn_rate) > options_.max_turn_rate)) return false;
-  // Only while the map still explains the scan as usual: once it does not, the view is needed.
-  return scan.matched && !scan.match_failed && scan.fits_as_usual &&
-         scan.fitness_ratio >= options_.min_fitness;
+  // Only while the map still explains the scan as usual: once it does not, the view is needed. (decide()
+  // asks only after a failed match has been dealt with.)
+  return scan.matched && scan.fits_as_usual && scan.fitness_ratio >= options_.min_fitness;
 }
 
 KeyframeAction KeyframePolicy::decide(const KeyframeCandidate& scan, bool map_empty) {
