@@ -90,7 +90,7 @@ void printFusion(std::FILE* out, const EvaluationRun& run) {
       out,
       "\nwheels        systematic errors learned: turn scale %+.4f, heading %+.3f deg/m, distance scale "
       "%+.4f; the laser sits (%+.3f, %+.3f) m from its mount",
-      last.wheel_turn_scale, last.wheel_heading_per_metre * 180.0 / M_PI, last.wheel_distance_scale,
+      last.wheel_turn_scale, last.wheel_heading_per_metre * hglasm::kRadToDeg, last.wheel_distance_scale,
       last.laser_offset.x(), last.laser_offset.y());
 }
 
@@ -260,8 +260,8 @@ void printContradicted(std::FILE* out, const char* short_label, const RelationsR
       "  contradicted: %d relations %s whose direct pair settles > %.0f deg from the reference's turn "
       "and within %.0f deg of the wheels'; without them (%d): laser %.4f / %.3f (median %.4f / %.3f), "
       "wheels %.4f / %.3f (median %.4f / %.3f), calibration %.2f\n",
-      report.contradicted, short_label, RelationsReport::kContradiction * 180.0 / M_PI,
-      RelationsReport::kAgreement * 180.0 / M_PI, laser.count, laser.trans_mean, laser.rot_mean_deg,
+      report.contradicted, short_label, RelationsReport::kContradiction * hglasm::kRadToDeg,
+      RelationsReport::kAgreement * hglasm::kRadToDeg, laser.count, laser.trans_mean, laser.rot_mean_deg,
       laser.trans_median, laser.rot_median_deg, wheel.trans_mean, wheel.rot_mean_deg, wheel.trans_median,
       wheel.rot_median_deg, report.calibration_uncontradicted.mean_sq_mahalanobis);
 }
