@@ -12,8 +12,9 @@
 #
 # usage: scripts/evaluate_all.sh [-e EVALUATE] [-d DATASETS] [-o OUT_DIR] [-p "small medium large"]
 #                                [-l "intel fr079"] [-- extra evaluate arguments]
-#   -e  the evaluate binary (default: $EVALUATE, then `catkin_find hglasm_odometry evaluate`,
-#       then ../build*/devel/lib/hglasm_odometry/evaluate next to the package)
+#   -e  the evaluate binary (default: $EVALUATE, then `catkin_find hglasm_odometry evaluate`, then the
+#       newest build*/devel/lib/hglasm_odometry/evaluate in the package (scripts/env.sh's hglasm_build) or
+#       beside it (a catkin workspace))
 #   -d  the datasets folder (default: <package>/../shared/datasets)
 #   -o  where run logs, trajectories and plots go (default: /tmp/hglasm_evaluate_all)
 #   -p  presets (default: the top-level keys of config/presets.yaml, else "small medium large")
@@ -44,10 +45,12 @@ shift $((OPTIND - 1))
 extra_args=("$@")
 
 if [[ -z "$evaluate" ]] && command -v catkin_find >/dev/null 2>&1; then
-  evaluate="$(catkin_find --first-only hglasm_odometry evaluate 2>/dev/null || true)"
+  evaluate="$(catkin_find --first-only hglasm_odometry evaluate 2>/dev/null | head -n1 || true)"
+  [[ -x "$evaluate" ]] || evaluate=""  # catkin_find also names install paths that do not exist
 fi
 if [[ -z "$evaluate" ]]; then
-  evaluate="$(ls -t "$package_dir"/../build*/devel/lib/hglasm_odometry/evaluate 2>/dev/null | head -n1 || true)"
+  evaluate="$(ls -t "$package_dir"/build*/devel/lib/hglasm_odometry/evaluate \
+                    "$package_dir"/../build*/devel/lib/hglasm_odometry/evaluate 2>/dev/null | head -n1 || true)"
 fi
 if [[ -z "$evaluate" || ! -x "$evaluate" ]]; then
   echo "evaluate_all: evaluate binary not found; build it and pass -e PATH (or set EVALUATE)" >&2
