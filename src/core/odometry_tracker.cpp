@@ -57,6 +57,7 @@ void OdometryTracker::reset() {
   learner_.restart();
   keyframes_.restart();
   set_pose_stamp_.reset();
+  unconfirmed_since_.reset();
 }
 
 bool OdometryTracker::setPose(double stamp, const Pose2D& pose, const Eigen::Matrix3d& covariance) {
@@ -103,6 +104,15 @@ TrackerUpdate OdometryTracker::processScan(double stamp, const Scan& sensor_scan
     update.fallback = true;  // nothing (convincing) to match: keep the motion predicted
     estimate = integratePrediction(prediction);
     if (usable) diagnostics.fitness_ratio = judge(scan).fitnessRatio(estimate.laser_in_map);
+    // A velocity's guess (intel's wheels arriving late) can be far off in a turn; once the wheels cover
+    // the span, they predict from the last pose a scan or the wheels stood behind, not from the guess.
+    if (prediction.source == PredictionSource::kOdometry) {
+      unconfirmed_since_.reset();
+    } else if (!unconfirmed_since_) {
+      unconfirmed_since_ = Anchor{last_stamp_, pose_};
+    }
+  } else {
+    unconfirmed_since_.reset();
   }
   advance(stamp, estimate, &update);
   updateMap(scan, usable, &update);
@@ -165,13 +175,29 @@ void OdometryTracker::advanceSetPose(double stamp, TrackerUpdate* update) {
 
 MotionPrediction OdometryTracker::predict(double stamp, TrackerUpdate* update) const {
   std::string warning;
-  const MotionPrediction prediction =
-      extrapolator_.predict(last_stamp_, stamp, learner_.wheelNoise(), &warning);
+  MotionPrediction prediction = extrapolator_.predict(last_stamp_, stamp, learner_.wheelNoise(), &warning);
+  if (prediction.source == PredictionSource::kOdometry && unconfirmed_since_) {
+    predictFromAnchor(stamp, &prediction);
+  }
   if (update->warning.empty()) update->warning = warning;
   update->diagnostics.prediction = prediction.source;
   update->diagnostics.rotation_from_imu = prediction.rotation_from_imu;
   update->diagnostics.guess = pose_ * prediction.motion;
   return prediction;
+}
+
+bool OdometryTracker::predictFromAnchor(double stamp, MotionPrediction* prediction) const {
+  std::string warning;
+  const MotionPrediction since =
+      extrapolator_.predict(unconfirmed_since_->stamp, stamp, learner_.wheelNoise(), &warning);
+  if (since.source != PredictionSource::kOdometry) return false;
+  // The same wheel motion, seen from the guessed pose: its covariance turns with the frame.
+  const Pose2D frame_change(0.0, 0.0, unconfirmed_since_->pose.theta - pose_.theta);
+  prediction->motion = relativePose(pose_, unconfirmed_since_->pose * since.motion);
+  prediction->covariance = rotateCovariance(frame_change, since.covariance);
+  prediction->nominal_covariance = rotateCovariance(frame_change, since.nominal_covariance);
+  prediction->rotation_from_imu = since.rotation_from_imu;
+  return true;
 }
 
 OdometryTracker::Prior OdometryTracker::priorFor(const MotionPrediction& prediction) const {

@@ -456,6 +456,29 @@ TEST(OdometryTracker, EmptyScansFallBackToTheOdometryGuess) {
   EXPECT_LT(hglasm_test::translationError(update.pose, robot.truth(4.0)), 0.02);
 }
 
+TEST(OdometryTracker, AVelocitysGuessNoScanConfirmedDoesNotAnchorTheWheels) {
+  // Turning in place at 1 rad/s for a second, then standing still; the wheels stall for 0.3 s just as the
+  // turn ends (intel's late wheels), so a scan there is predicted at the turn's constant velocity, 0.3 rad
+  // past where the robot stopped, and it cannot be matched. Once the wheels catch up they predict the
+  // next scan from the last matched pose, not from the guess.
+  Robot robot(TrackerOptions(), [](double t) { return Pose2D(0.0, 0.0, std::min(t, 1.0)); });
+  robot.enableOdometry(0.0, 0.0);
+  for (int i = 0; i <= 10; ++i) EXPECT_FALSE(robot.step(0.1 * i).fallback) << i;
+  const hglasm::Scan empty;
+  const TrackerUpdate guessed = robot.tracker().processScan(1.3, empty);  // the wheels end at 1.0
+  EXPECT_TRUE(guessed.fallback);
+  EXPECT_EQ(guessed.diagnostics.prediction, PredictionSource::kConstantVelocity);
+  EXPECT_GT(hglasm_test::rotationError(guessed.pose, robot.truth(1.3)), 0.2) << "the velocity's guess";
+  const TrackerUpdate next = robot.step(1.4);
+  expectSane(next);
+  EXPECT_EQ(next.diagnostics.prediction, PredictionSource::kOdometry);
+  hglasm_test::expectPoseNear(next.diagnostics.guess, robot.truth(1.4), 0.005, hglasm_test::deg(0.5),
+                              "the wheels' prediction");
+  EXPECT_FALSE(next.fallback);
+  EXPECT_FALSE(next.leap);
+  hglasm_test::expectPoseNear(next.pose, robot.truth(1.4), 0.02, hglasm_test::deg(0.5), "the match");
+}
+
 TEST(OdometryTracker, EmptyScansWithoutOdometryKeepTheConstantVelocity) {
   Robot robot(withoutOdometry(), straightPath(0.4));
   for (int i = 0; i <= 10; ++i) robot.step(0.1 * i);

@@ -233,6 +233,8 @@ class OdometryTracker {
   /// At the first scan after setPose(): moves the set pose on by the wheel motion since its stamp.
   void advanceSetPose(double stamp, TrackerUpdate* update);
   MotionPrediction predict(double stamp, TrackerUpdate* update) const;
+  /// The wheels' motion from unconfirmed_since_ to `stamp`, expressed from pose_ (false: none known).
+  bool predictFromAnchor(double stamp, MotionPrediction* prediction) const;
   Prior priorFor(const MotionPrediction& prediction) const;
   /// Matches against the local map with the prediction as prior, tests for a leap, learns from the match;
   /// false if no match is acceptable (the prediction is integrated).
@@ -286,6 +288,13 @@ class OdometryTracker {
   bool initialised_ = false;
   double last_stamp_ = 0.0;
   std::optional<double> set_pose_stamp_;  // setPose()'s stamp until the next scan starts from it
+  /// The last pose a scan or the wheels stand behind, while pose_ is a guess no scan confirmed (a
+  /// constant-velocity prediction integrated): the wheels' next prediction starts from there instead.
+  struct Anchor {
+    double stamp;
+    Pose2D pose;
+  };
+  std::optional<Anchor> unconfirmed_since_;
   Pose2D pose_;
   Eigen::Matrix3d pose_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d map_covariance_ = Eigen::Matrix3d::Zero();  // of the laser pose in the local map's frame
