@@ -186,18 +186,18 @@ MotionPrediction OdometryTracker::predict(double stamp, TrackerUpdate* update) c
   return prediction;
 }
 
-bool OdometryTracker::predictFromAnchor(double stamp, MotionPrediction* prediction) const {
+void OdometryTracker::predictFromAnchor(double stamp, MotionPrediction* prediction) const {
   std::string warning;
   const MotionPrediction since =
       extrapolator_.predict(unconfirmed_since_->stamp, stamp, learner_.wheelNoise(), &warning);
-  if (since.source != PredictionSource::kOdometry) return false;
-  // The same wheel motion, seen from the guessed pose: its covariance turns with the frame.
+  if (since.source != PredictionSource::kOdometry) return;
+  // The same wheel motion, seen from the guessed pose: its covariance turns with the frame. wheel_motion
+  // and dt stay the step's: after an unmatched scan the learners skip this step.
   const Pose2D frame_change(0.0, 0.0, unconfirmed_since_->pose.theta - pose_.theta);
   prediction->motion = relativePose(pose_, unconfirmed_since_->pose * since.motion);
   prediction->covariance = rotateCovariance(frame_change, since.covariance);
   prediction->nominal_covariance = rotateCovariance(frame_change, since.nominal_covariance);
   prediction->rotation_from_imu = since.rotation_from_imu;
-  return true;
 }
 
 OdometryTracker::Prior OdometryTracker::priorFor(const MotionPrediction& prediction) const {

@@ -233,8 +233,9 @@ class OdometryTracker {
   /// At the first scan after setPose(): moves the set pose on by the wheel motion since its stamp.
   void advanceSetPose(double stamp, TrackerUpdate* update);
   MotionPrediction predict(double stamp, TrackerUpdate* update) const;
-  /// The wheels' motion from unconfirmed_since_ to `stamp`, expressed from pose_ (false: none known).
-  bool predictFromAnchor(double stamp, MotionPrediction* prediction) const;
+  /// Replaces the prediction's motion and covariances by the wheels' motion from unconfirmed_since_ to
+  /// `stamp`, expressed from pose_; unchanged where the wheels do not cover that span.
+  void predictFromAnchor(double stamp, MotionPrediction* prediction) const;
   Prior priorFor(const MotionPrediction& prediction) const;
   /// Matches against the local map with the prediction as prior, tests for a leap, learns from the match;
   /// false if no match is acceptable (the prediction is integrated).
