@@ -72,10 +72,10 @@ int evaluate(const EvaluateArguments& args) {
     printRelationsReport(stdout, args.relations, inputs.relations, report, data.base_frame, !wheel.empty());
     printSummary(stdout, nodelet.preset, run, report);
     if (args.blend_wheels && !wheel.empty()) {
-      printWheelBlends(stdout, inputs.relations, run.trajectory, wheel, args.short_span);
+      printWheelBlends(stdout, inputs.relations, run.scored, wheel, args.short_span);
     }
     if (!args.relation_errors.empty()) {
-      if (!hglasm::writeRelationErrors(args.relation_errors, inputs.relations, run.trajectory, wheel)) {
+      if (!hglasm::writeRelationErrors(args.relation_errors, inputs.relations, run.scored, wheel)) {
         return fail("cannot write " + args.relation_errors, 1);
       }
       std::printf("relations     per-relation errors in %s\n", args.relation_errors.c_str());

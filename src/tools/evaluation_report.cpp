@@ -142,7 +142,7 @@ void judgeReference(const std::vector<hglasm::Relation>& relations, const Evalua
       rest.push_back(relations[k]);
     }
   }
-  report->laser_short_uncontradicted = hglasm::evaluateRelations(rest, run.trajectory, report->short_span);
+  report->laser_short_uncontradicted = hglasm::evaluateRelations(rest, run.scored, report->short_span);
   report->wheel_short_uncontradicted = hglasm::evaluateRelations(rest, wheel_trajectory, report->short_span);
   report->calibration_uncontradicted =
       hglasm::evaluateCalibration(rest, run.trajectory, incrementCovariances(run), report->short_span);
@@ -155,16 +155,16 @@ RelationsReport evaluateRun(const std::vector<hglasm::Relation>& relations, cons
                             double short_span, const hglasm::TrackerOptions* direct_pairs_options) {
   RelationsReport report;
   report.short_span = short_span;
-  report.laser_all = hglasm::evaluateRelations(relations, run.trajectory, 0.0);
+  report.laser_all = hglasm::evaluateRelations(relations, run.scored, 0.0);
   report.wheel_all = hglasm::evaluateRelations(relations, wheel_trajectory, 0.0);
-  report.laser_short = hglasm::evaluateRelations(relations, run.trajectory, short_span);
+  report.laser_short = hglasm::evaluateRelations(relations, run.scored, short_span);
   report.wheel_short = hglasm::evaluateRelations(relations, wheel_trajectory, short_span);
   // The reference relations come from aligning scans, so they may describe the laser's motion.
   report.laser_frame = data.has_laser_mount && !(data.base_to_laser.translationNorm() < 1e-9 &&
                                                  std::abs(data.base_to_laser.theta) < 1e-9);
   report.laser_frame_short = report.laser_short;
   if (report.laser_frame) {
-    const auto laser = hglasm::followedBy(run.trajectory, data.base_to_laser);
+    const auto laser = hglasm::followedBy(run.scored, data.base_to_laser);
     const auto wheel = hglasm::followedBy(wheel_trajectory, data.base_to_laser);
     report.laser_frame_all = hglasm::evaluateRelations(relations, laser, 0.0);
     report.wheel_laser_frame_all = hglasm::evaluateRelations(relations, wheel, 0.0);
@@ -173,13 +173,13 @@ RelationsReport evaluateRun(const std::vector<hglasm::Relation>& relations, cons
   }
   // Turn rates from the wheels where there are any: their timing is the bag's, not the fusion's.
   const std::vector<hglasm::StampedPose>& turn_rates =
-      wheel_trajectory.empty() ? run.trajectory : wheel_trajectory;
+      wheel_trajectory.empty() ? run.scored : wheel_trajectory;
   const auto timing = [&](const RelativeMotions& estimate) {
     return hglasm::fitTimingOffset(relations, estimate.motions, estimate.valid, turn_rates, short_span);
   };
   const RelativeMotions wheels = relativeMotionsOf(relations, wheel_trajectory);
   report.has_timing = true;
-  report.laser_timing = timing(relativeMotionsOf(relations, run.trajectory));
+  report.laser_timing = timing(relativeMotionsOf(relations, run.scored));
   if (!wheel_trajectory.empty()) report.wheel_timing = timing(wheels);
   if (direct_pairs_options) {
     RelativeMotions direct;
@@ -192,7 +192,7 @@ RelationsReport evaluateRun(const std::vector<hglasm::Relation>& relations, cons
   }
   report.calibration =
       hglasm::evaluateCalibration(relations, run.trajectory, incrementCovariances(run), short_span);
-  worstRelations(relations, run.trajectory, wheel_trajectory, &report);
+  worstRelations(relations, run.scored, wheel_trajectory, &report);
   return report;
 }
 
@@ -234,6 +234,12 @@ void printRun(std::FILE* out, const EvaluationRun& run, double data_seconds, boo
       run.stale, static_cast<unsigned long long>(run.inputs.stale_odometry),
       static_cast<unsigned long long>(run.inputs.jumps_back), run.replay.queue_drops,
       run.replay.wait_timeouts);
+  if (run.interpolated) {
+    std::fprintf(out,
+                 "scored        %zu scans not published are scored at the pose interpolated between the "
+                 "published ones around them (what tf gives there)\n",
+                 run.interpolated);
+  }
   std::fprintf(out, "local map     re-anchored %d times (a scan that did not fit it)\n", run.reanchored);
   std::fprintf(out, "odometry lag  time offset %.3f s in use at the end (odometry/time_offset)\n",
                run.time_offset);

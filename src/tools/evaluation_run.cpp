@@ -74,6 +74,25 @@ std::vector<BagArrival> thinnedArrivals(const BagData& data, double interval, st
   return kept;
 }
 
+void scoreAtEveryScan(const BagData& data, EvaluationRun* run) {
+  const std::vector<hglasm::StampedPose>& published = run->trajectory;
+  run->scored.clear();
+  run->interpolated = 0;
+  std::size_t next = 0;  // the first published pose at or after the scan's stamp
+  for (const BagScan& scan : data.scans) {
+    while (next < published.size() && published[next].stamp < scan.stamp) ++next;
+    if (next < published.size() && published[next].stamp == scan.stamp) {
+      run->scored.push_back(published[next]);
+    } else if (next > 0 && next < published.size()) {
+      const hglasm::StampedPose& before = published[next - 1];
+      const hglasm::StampedPose& after = published[next];
+      const double t = (scan.stamp - before.stamp) / (after.stamp - before.stamp);
+      run->scored.push_back({scan.stamp, hglasm::interpolate(before.pose, after.pose, t)});
+      ++run->interpolated;
+    }
+  }
+}
+
 EvaluationRun runEvaluation(const BagData& data, const LaserOdometryOptions& nodelet,
                             const hglasm::TrackerOptions& tracker, double min_scan_interval,
                             std::size_t warnings_kept) {
@@ -93,6 +112,7 @@ EvaluationRun runEvaluation(const BagData& data, const LaserOdometryOptions& nod
   }
   run.inputs = pipeline.inputCounts();
   run.time_offset = pipeline.odometryTimeOffset();
+  scoreAtEveryScan(data, &run);
   return run;
 }
 

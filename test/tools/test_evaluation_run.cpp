@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -104,6 +105,30 @@ TEST(EvaluationRun, ThinningDropsScansAndKeepsTheOdometry) {
   const EvaluationRun thinned = runEvaluation(data, slice().options, slice().options.tracker, 0.5);
   EXPECT_EQ(thinned.skipped, skipped);
   EXPECT_EQ(thinned.processed, scans);
+  // The relations are scored at every scan, the skipped ones at the pose interpolated between the
+  // published ones around them, not left out (a run that drops scans must not drop its hard relations).
+  ASSERT_EQ(thinned.trajectory.size(), scans);
+  const double last_published = thinned.trajectory.back().stamp;
+  int beyond = 0;  // relations that end after the last published pose: nothing to interpolate there
+  for (const hglasm::Relation& relation : slice().relations) {
+    beyond += std::max(relation.t1, relation.t2) > last_published + 1e-3;
+  }
+  const int missing = hglasm::evaluateRelations(slice().relations, thinned.trajectory, 0.0).missing;
+  EXPECT_GT(missing, 10 * beyond);
+  EXPECT_EQ(hglasm::evaluateRelations(slice().relations, thinned.scored, 0.0).missing, beyond);
+  std::size_t within = 0;
+  for (const BagScan& scan : data.scans) within += scan.stamp <= last_published;
+  EXPECT_EQ(thinned.scored.size(), within) << "every scan up to the last published one";
+  EXPECT_EQ(thinned.interpolated, within - scans);
+  const hglasm::StampedPose& before = thinned.trajectory[0];
+  const hglasm::StampedPose& after = thinned.trajectory[1];
+  const hglasm::StampedPose& between = thinned.scored[1];
+  ASSERT_GT(between.stamp, before.stamp);
+  ASSERT_LT(between.stamp, after.stamp);
+  const hglasm::Pose2D expected = hglasm::interpolate(
+      before.pose, after.pose, (between.stamp - before.stamp) / (after.stamp - before.stamp));
+  EXPECT_EQ(between.pose.x, expected.x);
+  EXPECT_EQ(between.pose.theta, expected.theta);
 }
 
 TEST(EvaluationRun, WheelBaselineIsTheBagsOdometryAtTheScanStamps) {

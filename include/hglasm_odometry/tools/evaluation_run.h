@@ -21,7 +21,12 @@ namespace hglasm_odometry {
 /// What one pass of the pipeline over the bag produced.
 struct EvaluationRun {
   std::vector<hglasm::StampedPose> trajectory;  ///< published base poses, by stamp
-  std::vector<hglasm::TrackerUpdate> updates;   ///< every published scan's update, in order
+  /// What the relations score: the published poses and, at every scan the pipeline did not publish (dropped
+  /// by the time policy or the queue), the pose interpolated between the published ones around it (what tf
+  /// gives at that time), so that every relation is scored; `interpolated` of them.
+  std::vector<hglasm::StampedPose> scored;
+  std::size_t interpolated = 0;
+  std::vector<hglasm::TrackerUpdate> updates;  ///< every published scan's update, in order
   std::size_t processed = 0, skipped = 0, stale = 0;
   int matched = 0, fallbacks = 0, keyframes = 0, resets = 0, conversion_errors = 0, warnings = 0;
   int deskewed = 0, reanchored = 0;
@@ -40,6 +45,10 @@ struct EvaluationRun {
 EvaluationRun runEvaluation(const BagData& data, const LaserOdometryOptions& nodelet,
                             const hglasm::TrackerOptions& tracker, double min_scan_interval,
                             std::size_t warnings_kept = 20);
+
+/// run->scored and run->interpolated from run->trajectory at the stamps of `data`'s scans (both sorted by
+/// stamp); scans before the first published pose or after the last stay unscored.
+void scoreAtEveryScan(const BagData& data, EvaluationRun* run);
 
 /// The arrivals of `data` but for the scans stamped less than `interval` s after the last one kept.
 std::vector<BagArrival> thinnedArrivals(const BagData& data, double interval, std::size_t* skipped);
