@@ -48,6 +48,26 @@ double LeapDetector::wrongPrior() const {
       1.0 - 1e-12);
 }
 
+double LeapDetector::priorWeight(double innovation_sq) const {
+  const double k = options_.slip_variance_scale;
+  if (!(k > 1.0) || !std::isfinite(innovation_sq)) return 1.0;
+  // Beyond the slip component's own gate: not a slip, a prediction that says nothing.
+  if (innovation_sq > k * options_.max_mahalanobis * options_.max_mahalanobis) return 0.0;
+  const double p = std::min(0.5, faultRate());
+  // The two components' densities in 3 dimensions, relative to the first's at the innovation (no underflow).
+  const double slip_odds =
+      p / (1.0 - p) * std::pow(k, -1.5) * std::exp(0.5 * innovation_sq * (1.0 - 1.0 / k));
+  const double slipped = std::isfinite(slip_odds) ? slip_odds / (1.0 + slip_odds) : 1.0;
+  return 1.0 - slipped + slipped / k;
+}
+
+Eigen::Matrix3d LeapDetector::slipCovariance(const Pose2D& motion) const {
+  // Isotropic in translation, so the same in the base's and the map's frame.
+  const double mount_sq = options_.slip_mount_sigma * options_.slip_mount_sigma;
+  const double translation = mount_sq * (2.0 - 2.0 * std::cos(motion.theta));
+  return Eigen::Vector3d(translation, translation, 0.0).asDiagonal();
+}
+
 LeapHypotheses LeapDetector::hypotheses(const Pose2D& mean, const Eigen::Matrix3d& covariance,
                                         const Eigen::Vector3d& box_variances) const {
   LeapHypotheses h;

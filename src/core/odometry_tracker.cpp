@@ -1,5 +1,6 @@
 #include "hglasm_odometry/core/odometry_tracker.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -219,6 +220,24 @@ OdometryTracker::Prior OdometryTracker::priorFor(const MotionPrediction& predict
   return prior;
 }
 
+void OdometryTracker::refineIfSlipped(const Scan& scan, const ScanJudge& scan_judge,
+                                      const MotionPrediction& prediction, const LeapHypotheses& h,
+                                      MatchCandidate* tight, TrackerDiagnostics* diagnostics) {
+  if (!tight->acceptable) return;
+  const Eigen::Vector3d innovation = poseDifference(tight->match.scan_only_pose, h.prior.mean);
+  const Eigen::Matrix3d total = h.covariance + covarianceOfInformation(tight->match.scan_information) +
+                                leap_detector_.slipCovariance(prediction.motion);
+  const double weight = leap_detector_.priorWeight(innovation.dot(total.ldlt().solve(innovation)));
+  if (!(weight < options_.leap.slip_refine_below)) return;
+  PosePrior softened = h.prior;
+  softened.information *= weight;
+  const MatchCandidate refined =
+      candidate(scan_judge, matcher_.refine(scan, tight->match.pose, &softened), h.prior);
+  if (!refined.acceptable || refined.fitness_ratio < tight->fitness_ratio) return;
+  *tight = refined;
+  diagnostics->prior_weight = weight;
+}
+
 bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& prediction,
                                 std::vector<Pose2D>* population_out, TrackerUpdate* update,
                                 Estimate* estimate) {
@@ -231,11 +250,14 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   const ScanJudge scan_judge = judge(scan);
   diagnostics.search =
       prior.informative ? searchAround(options_.matcher.genetic, options_.search, h.covariance) : wide_search;
-  const MatchCandidate tight =
-      candidate(scan_judge,
-                matcher_.match(scan, h.prior.mean, population_out, &diagnostics.search,
-                               options_.fusion ? &h.prior : nullptr),
-                h.prior);
+  MatchCandidate tight = candidate(scan_judge,
+                                   matcher_.match(scan, h.prior.mean, population_out, &diagnostics.search,
+                                                  options_.fusion ? &h.prior : nullptr),
+                                   h.prior);
+  // An IMU's rotation does not slip with the wheels: its prior is left as predicted.
+  if (prior.informative && !prediction.rotation_from_imu) {
+    refineIfSlipped(scan, scan_judge, prediction, h, &tight, &diagnostics);
+  }
   // A prediction in doubt: the preset's whole box is searched under the second hypothesis.
   std::vector<Pose2D> wide_population;
   std::function<MatchCandidate()> search_wide;

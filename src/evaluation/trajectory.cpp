@@ -126,13 +126,13 @@ bool writeTrackerTrace(const std::string& path, const std::vector<TrackerUpdate>
       "box_x box_y box_theta population mahalanobis fitness status mbicp_iterations noise_xy "
       "noise_theta guess_x guess_y guess_theta leap_probability vx vy wz time_offset scan_noise_weakest "
       "scan_noise_middle scan_noise_strongest degeneracy weakest_x weakest_y weakest_theta turn_scale "
-      "laser_offset_x laser_offset_y\n");
+      "laser_offset_x laser_offset_y prior_weight\n");
   for (const auto& u : updates) {
     const TrackerDiagnostics& d = u.diagnostics;
     std::fprintf(
         file,
         "%.6f %.4f %.4f %.5f %s %d %d %d %d %d %d %d %.3f %.3f %.3f %d %.2f %.3f %s %d %.3g %.3g "
-        "%.4f %.4f %.5f %.3g %.4f %.4f %.4f %.3f %.3g %.3g %.3g %.3g %.3f %.3f %.3f %.5f %.4f %.4f\n",
+        "%.4f %.4f %.5f %.3g %.4f %.4f %.4f %.3f %.3g %.3g %.3g %.3g %.3f %.3f %.3f %.5f %.4f %.4f %.3g\n",
         u.stamp, u.pose.x, u.pose.y, u.pose.theta, toString(d.prediction), u.matched, u.fallback,
         d.prediction_doubted, u.leap, d.jump_rejected, u.new_keyframe, d.map_keyframes, d.search.box.half_x,
         d.search.box.half_y, d.search.box.half_theta, d.search.population, d.prior_mahalanobis,
@@ -141,7 +141,7 @@ bool writeTrackerTrace(const std::string& path, const std::vector<TrackerUpdate>
         u.velocity.y(), u.velocity.z(), d.odometry_time_offset, d.learned.scan_noise[0],
         d.learned.scan_noise[1], d.learned.scan_noise[2], d.degeneracy, d.weakest_direction.x(),
         d.weakest_direction.y(), d.weakest_direction.z(), d.learned.wheel_turn_scale,
-        d.learned.laser_offset.x(), d.learned.laser_offset.y());
+        d.learned.laser_offset.x(), d.learned.laser_offset.y(), d.prior_weight);
   }
   return std::fclose(file) == 0;
 }

@@ -275,6 +275,48 @@ TEST(LeapDetector, WheelsRarelyWrongLeapOnlyWhenTheNextScanAsksForTheSameCorrect
   EXPECT_TRUE(slipped(detector, room, 0.4).deferred);
 }
 
+TEST(LeapDetector, ASlipSoftensThePriorByItsPosteriorProbability) {
+  // Wheels with no record yet: slip probability p = confirm_below = 1e-3, the slip component 9 times
+  // wider. The prior's weight is 1 - w + w / 9 for the slip's posterior probability w at the innovation.
+  const LeapDetector detector;
+  ASSERT_DOUBLE_EQ(detector.faultRate(), 1e-3);
+  const double k = detector.options().slip_variance_scale;
+  ASSERT_EQ(k, 9.0);
+  const double odds_at_zero = 1e-3 / (1.0 - 1e-3) * std::pow(k, -1.5);
+  const double w0 = odds_at_zero / (1.0 + odds_at_zero);
+  EXPECT_NEAR(detector.priorWeight(0.0), 1.0 - w0 + w0 / k, 1e-15);
+  // Where both components are equally likely: w = 1/2.
+  const double even = -2.0 * std::log(odds_at_zero) / (1.0 - 1.0 / k);
+  EXPECT_NEAR(detector.priorWeight(even), 0.5 + 0.5 / k, 1e-12);
+  double previous = 1.0;
+  for (double q = 0.0; q <= k * 16.0; q += 1.0) {
+    EXPECT_LE(detector.priorWeight(q), previous + 1e-15) << q;
+    previous = detector.priorWeight(q);
+  }
+  EXPECT_NEAR(detector.priorWeight(k * 16.0), 1.0 / k, 1e-6) << "a slip, surely";
+  // Beyond the slip component's own max_mahalanobis (4): no slip either, a prediction that says nothing.
+  EXPECT_EQ(detector.priorWeight(k * 16.0 + 1e-6), 0.0);
+  EXPECT_EQ(detector.priorWeight(std::nan("")), 1.0);
+  // Wheels often wrong slip more readily; without the mixture the prior stays.
+  const LeapDetector often = withHistory(2000, 80);
+  EXPECT_LT(often.priorWeight(20.0), 0.3);
+  EXPECT_GT(detector.priorWeight(20.0), 0.7);
+  hglasm::LeapOptions off;
+  off.slip_variance_scale = 0.0;
+  EXPECT_EQ(LeapDetector(off).priorWeight(1e6), 1.0);
+}
+
+TEST(LeapDetector, TheSlipTestAllowsForTheMountInTurns) {
+  // A mount known to 0.1 m moves a step that turns by a by (R(a) - I) m: variance 0.01 (2 - 2 cos a).
+  const LeapDetector detector;
+  EXPECT_TRUE(detector.slipCovariance(Pose2D(0.5, 0.0, 0.0)).isZero()) << "no turn, nothing";
+  const Eigen::Matrix3d quarter = detector.slipCovariance(Pose2D(0.0, 0.0, M_PI / 2));
+  EXPECT_NEAR(quarter(0, 0), 0.02, 1e-15);
+  EXPECT_NEAR(quarter(1, 1), 0.02, 1e-15);
+  EXPECT_EQ(quarter(2, 2), 0.0);
+  EXPECT_EQ(quarter(0, 1), 0.0);
+}
+
 TEST(LeapDetector, WheelsOftenWrongLeapAtOnce) {
   const Room room;
   const LeapDetector detector = withHistory(2000, 80);  // 4 % of the scans, as intel's wheels do

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <random>
 #include <utility>
 
 #include "simulated_robot.h"
@@ -477,6 +478,50 @@ TEST(OdometryTracker, AVelocitysGuessNoScanConfirmedDoesNotAnchorTheWheels) {
   EXPECT_FALSE(next.fallback);
   EXPECT_FALSE(next.leap);
   hglasm_test::expectPoseNear(next.pose, robot.truth(1.4), 0.02, hglasm_test::deg(0.5), "the match");
+}
+
+/// Mean translation error over 3 s to 30 s of the circle, with wheels that slip by up to `size` (m on each
+/// axis, rad) every `every` scans from 2 s on (a seeded draw), the tracker's options `options`.
+double meanErrorWithSlips(const TrackerOptions& options, double size, int every) {
+  Robot robot(options, circlePath);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> draw(-1.0, 1.0);
+  Pose2D slip;  // what the wheels have lost so far, in their frame
+  double sum = 0.0;
+  int count = 0;
+  for (int i = 0; i <= 300; ++i) {
+    const double t = 0.1 * i;
+    if (i > 20 && i % every == 0)
+      slip = Pose2D(size * draw(random), size * draw(random), size * draw(random)) * slip;
+    for (int j = i > 0 ? 8 : 0; j >= 0; --j) {  // wheels at 100 Hz up to the scan
+      robot.tracker().addOdometry(t - 0.01 * j, slip * robot.truth(t - 0.01 * j));
+    }
+    const TrackerUpdate update = robot.tracker().processScan(t, robot.scanAt(t));
+    expectSane(update);
+    if (i > 30) {
+      sum += hglasm_test::translationError(update.pose, robot.truth(t));
+      ++count;
+    }
+  }
+  return sum / count;
+}
+
+TEST(OdometryTracker, WheelsThatSlipNowAndThenAreCorrectedNotCarriedOn) {
+  // Each slip is a few sigma of the wheels' learned noise: too small for a leap, large enough that a prior
+  // this tight would hold the match near it and pass it on. The slip mixture gives those scans to the scan.
+  for (const double size : {0.02, 0.04, 0.08}) {
+    for (const int every : {5, 20}) {
+      SCOPED_TRACE("slips up to " + std::to_string(size) + " every " + std::to_string(every) + " scans");
+      TrackerOptions options;
+      const double with_mixture = meanErrorWithSlips(options, size, every);
+      options.leap.slip_variance_scale = 0.0;
+      const double without = meanErrorWithSlips(options, size, every);
+      std::printf("slips up to %.2f every %d scans: mean error %.4f m, without the slip mixture %.4f m\n",
+                  size, every, with_mixture, without);
+      EXPECT_LT(with_mixture, 0.006);
+      EXPECT_GT(without, 2.0 * with_mixture) << "the mechanism: without it the slips are carried on";
+    }
+  }
 }
 
 TEST(OdometryTracker, EmptyScansWithoutOdometryKeepTheConstantVelocity) {

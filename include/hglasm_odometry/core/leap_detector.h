@@ -34,6 +34,19 @@ struct LeapOptions {
   /// an IMU (whose bias the scans teach), are corrected at once.
   bool confirm = true;
   double confirm_below = 1e-3;  ///< the prior odds of a leap, as `probability`
+  /// A moderate slip: the wheels' prediction is a mixture of their noise model and, with the probability
+  /// their faults have shown (LeapDetector::faultRate), a component `slip_variance_scale` times wider. After
+  /// the match, the prior's information is scaled by its expected precision under that mixture's posterior
+  /// at the innovation; below `slip_refine_below` MbICP refines again under the softened prior, and the
+  /// refinement is kept where the scan fits the map better there. An innovation beyond `max_mahalanobis`
+  /// of the slip component itself is no slip but a prediction that says nothing (stale wheel samples, a
+  /// stall): the refinement drops the prior (the leap test still weighs the match against the prediction).
+  /// 0 turns it off.
+  double slip_variance_scale = 9.0;
+  double slip_refine_below = 0.9;
+  /// The laser's place on the robot known to this standard deviation (m) in that test: it moves the laser's
+  /// predicted step by (R(turn) - I) times its error, so a disagreement in a turn is not taken for a slip.
+  double slip_mount_sigma = 0.1;
 };
 
 /// Its parameters and their valid ranges, for OptionReader and OptionWriter (parameter_source.h).
@@ -45,6 +58,9 @@ void visitOptions(Visitor& visitor, LeapOptions* options) {
   visitor.number("leap/likelihood_outlier", &options->likelihood_outlier, 0.0, 1.0, true);
   visitor.boolean("leap/confirm", &options->confirm);
   visitor.number("leap/confirm_below", &options->confirm_below, 0.0, 1.0, true);
+  visitor.nonNegativeNumber("leap/slip_variance_scale", &options->slip_variance_scale);
+  visitor.fraction("leap/slip_refine_below", &options->slip_refine_below);
+  visitor.nonNegativeNumber("leap/slip_mount_sigma", &options->slip_mount_sigma);
 }
 
 /// The two hypotheses a scan is matched under, in the local map's frame (the laser's pose).
@@ -142,6 +158,15 @@ class LeapDetector {
   double faultRate() const {
     return (options_.confirm_below * kTrustScans + faults_) / (kTrustScans + scans_);
   }
+  /// The scale of the wheels' prior information after a match whose innovation lies at squared
+  /// Mahalanobis distance `innovation_sq` (in the wheels', the scan's and slipCovariance()'s summed
+  /// covariance): 1 - w + w / k for the posterior probability w of the slip component (k times the variance,
+  /// probability faultRate(); LeapOptions::slip_variance_scale); 0 beyond max_mahalanobis of that
+  /// component. 1 when slips are off.
+  double priorWeight(double innovation_sq) const;
+  /// The innovation covariance's part for what the wheels' model leaves out (LeapOptions::slip_mount_sigma)
+  /// for a predicted base motion `motion`.
+  Eigen::Matrix3d slipCovariance(const Pose2D& motion) const;
   /// Whether a far leap waits for the next scan's confirmation (LeapOptions::confirm).
   bool confirmationRequired() const { return options_.confirm && faultRate() < options_.confirm_below; }
   static constexpr double kFaultHalfLife = 2000.0;  // scans

@@ -107,6 +107,9 @@ struct TrackerDiagnostics {
   /// map or a usable scan.
   double fitness_ratio = 0.0;
   double prior_mahalanobis = 0.0;  ///< Mahalanobis distance of the match from the prediction
+  /// The scale the wheels' prior information was refined under after the slip test (1: as predicted;
+  /// LeapOptions::slip_variance_scale).
+  double prior_weight = 1.0;
   /// What the scene constrains (InformationDirections of the match): 0 for a direction the scan says
   /// nothing about (a featureless corridor's axis), and that weakest direction (x, y, theta). 0 and zero
   /// without a match.
@@ -236,6 +239,10 @@ class OdometryTracker {
   /// Replaces the prediction's motion and covariances by the wheels' motion from unconfirmed_since_ to
   /// `stamp`, expressed from pose_; unchanged where the wheels do not cover that span.
   void predictFromAnchor(double stamp, MotionPrediction* prediction) const;
+  /// Where the match's innovation says the wheels more likely slipped than not, MbICP refines again under
+  /// their prior softened by LeapDetector::priorWeight(); kept where the scan fits the map better there.
+  void refineIfSlipped(const Scan& scan, const ScanJudge& scan_judge, const MotionPrediction& prediction,
+                       const LeapHypotheses& h, MatchCandidate* tight, TrackerDiagnostics* diagnostics);
   Prior priorFor(const MotionPrediction& prediction) const;
   /// Matches against the local map with the prediction as prior, tests for a leap, learns from the match;
   /// false if no match is acceptable (the prediction is integrated).
