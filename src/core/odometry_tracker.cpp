@@ -254,8 +254,9 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
                                    matcher_.match(scan, h.prior.mean, population_out, &diagnostics.search,
                                                   options_.fusion ? &h.prior : nullptr),
                                    h.prior);
-  // An IMU's rotation does not slip with the wheels: its prior is left as predicted.
-  if (prior.informative && !prediction.rotation_from_imu) {
+  // An IMU's rotation does not slip with the wheels: its prior is left as predicted. Without fusion the
+  // match never had the prior.
+  if (options_.fusion && prior.informative && !prediction.rotation_from_imu) {
     refineIfSlipped(scan, scan_judge, prediction, h, &tight, &diagnostics);
   }
   // A prediction in doubt: the preset's whole box is searched under the second hypothesis.
