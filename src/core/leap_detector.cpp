@@ -12,6 +12,14 @@ double logPrior(const Pose2D& pose, const PosePrior& prior, const Eigen::Matrix3
   return logNormalDensity(poseDifference(pose, prior.mean), prior.information, covariance);
 }
 
+/// Squared Mahalanobis distance of where the scan alone would put the pose from the prediction, in their
+/// summed covariance plus `extra` (directions the scan does not constrain carry no innovation).
+double scanInnovationSq(const MatchCandidate& tight, const LeapHypotheses& h, const Eigen::Matrix3d& extra) {
+  const Eigen::Vector3d innovation = poseDifference(tight.match.scan_only_pose, h.prior.mean);
+  const Eigen::Matrix3d total = h.covariance + covarianceOfInformation(tight.match.scan_information) + extra;
+  return innovation.dot(total.ldlt().solve(innovation));
+}
+
 }  // namespace
 
 LeapDetector::LeapDetector(const LeapOptions& options) : options_(options) {}
@@ -61,6 +69,12 @@ double LeapDetector::priorWeight(double innovation_sq) const {
   return 1.0 - slipped + slipped / k;
 }
 
+double LeapDetector::slipWeight(const MatchCandidate& tight, const LeapHypotheses& h,
+                                const Pose2D& motion) const {
+  if (!tight.acceptable) return 1.0;
+  return priorWeight(scanInnovationSq(tight, h, slipCovariance(motion)));
+}
+
 Eigen::Matrix3d LeapDetector::slipCovariance(const Pose2D& motion) const {
   // Isotropic in translation, so the same in the base's and the map's frame.
   const double mount_sq = options_.slip_mount_sigma * options_.slip_mount_sigma;
@@ -87,10 +101,7 @@ bool LeapDetector::inDoubt(const MatchCandidate& tight, const LeapHypotheses& h,
   if (!tight.acceptable || tight.mahalanobis_sq > gate_sq) return true;
   // The scan fits the map far worse than scans usually do: the pose near the prediction is not its place.
   if (!fitness.usual(tight.fitness_ratio)) return true;
-  const Eigen::Vector3d innovation = poseDifference(tight.match.scan_only_pose, h.prior.mean);
-  const Eigen::Matrix3d total = h.covariance + covarianceOfInformation(tight.match.scan_information);
-  const double innovation_sq = innovation.dot(total.ldlt().solve(innovation));
-  return !(innovation_sq <= gate_sq);
+  return !(scanInnovationSq(tight, h, Eigen::Matrix3d::Zero()) <= gate_sq);
 }
 
 LogPosteriors LeapDetector::logPosteriors(const ScanJudge& judge, const LeapHypotheses& h,

@@ -1,6 +1,5 @@
 #include "hglasm_odometry/core/odometry_tracker.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -223,11 +222,7 @@ OdometryTracker::Prior OdometryTracker::priorFor(const MotionPrediction& predict
 void OdometryTracker::refineIfSlipped(const Scan& scan, const ScanJudge& scan_judge,
                                       const MotionPrediction& prediction, const LeapHypotheses& h,
                                       MatchCandidate* tight, TrackerDiagnostics* diagnostics) {
-  if (!tight->acceptable) return;
-  const Eigen::Vector3d innovation = poseDifference(tight->match.scan_only_pose, h.prior.mean);
-  const Eigen::Matrix3d total = h.covariance + covarianceOfInformation(tight->match.scan_information) +
-                                leap_detector_.slipCovariance(prediction.motion);
-  const double weight = leap_detector_.priorWeight(innovation.dot(total.ldlt().solve(innovation)));
+  const double weight = leap_detector_.slipWeight(*tight, h, prediction.motion);
   if (!(weight < options_.leap.slip_refine_below)) return;
   PosePrior softened = h.prior;
   softened.information *= weight;

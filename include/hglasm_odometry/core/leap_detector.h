@@ -164,6 +164,9 @@ class LeapDetector {
   /// probability faultRate(); LeapOptions::slip_variance_scale); 0 beyond max_mahalanobis of that
   /// component. 1 when slips are off.
   double priorWeight(double innovation_sq) const;
+  /// priorWeight() for the match `tight` near the prediction of `h` (a base motion `motion`): where the scan
+  /// alone would put the pose against the prediction; 1 without an acceptable match.
+  double slipWeight(const MatchCandidate& tight, const LeapHypotheses& h, const Pose2D& motion) const;
   /// The innovation covariance's part for what the wheels' model leaves out (LeapOptions::slip_mount_sigma)
   /// for a predicted base motion `motion`.
   Eigen::Matrix3d slipCovariance(const Pose2D& motion) const;
