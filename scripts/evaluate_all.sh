@@ -3,12 +3,12 @@
 # and prints one table: relations metric (all and <= 10 s, and the <= 10 s median translation) of the laser
 # odometry next to the raw wheel odometry, the wheels' time offset found (odometry/time_offset), fallbacks,
 # CPU per scan, the covariance calibration (mean squared Mahalanobis distance of the <= 10 s relations; 3 is
-# honest), the along-track scale of the <= 10 s relations (laser/wheels: the distance travelled along the
-# reference's direction over the reference's; 1 is unbiased), the leap ratio (largest <= 10 s error /
-# (3 x the wheels' + 0.10 m); above 1 is a leap) and the timing of laser and wheels against the reference
-# (ms) and their turn scale against it (%), fitted jointly: heading error = timing x change of turn rate
-# + turn scale x the reference's turn (0 / 0: the reference's clock and turns). Logs, trajectories,
-# traces and plots of each run go to the output directory.
+# honest), the along-track scale of the <= 10 s relations that move >= 0.1 m (laser/wheels: the distance
+# travelled along the reference's direction over the reference's; 1 is unbiased), the leap ratio (largest
+# <= 10 s error / (3 x the wheels' + 0.10 m); above 1 is a leap) and the timing of laser and wheels against
+# the reference (ms) and their turn scale against it (%), fitted jointly: heading error = timing x change of
+# turn rate + turn scale x the reference's turn (0 / 0: the reference's clock and turns). Logs,
+# trajectories, traces and plots of each run go to the output directory.
 #
 # usage: scripts/evaluate_all.sh [-e EVALUATE] [-d DATASETS] [-o OUT_DIR] [-p "small medium large"]
 #                                [-l "intel fr079"] [-- extra evaluate arguments]

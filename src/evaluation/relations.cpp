@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <numeric>
 #include <sstream>
 
 #include "hglasm_odometry/evaluation/statistics.h"
@@ -42,6 +43,23 @@ bool headingAt(const std::vector<StampedPose>& trajectory, double stamp, double*
   const double fraction = b.stamp > a.stamp ? (stamp - a.stamp) / (b.stamp - a.stamp) : 0.0;
   *heading = a.pose.theta + fraction * normalizeAngle(b.pose.theta - a.pose.theta);
   return true;
+}
+
+/// The ratio of the sums and its standard error: the residuals of the relations about the scale times
+/// their distances, as a ratio estimator's.
+void setAlongTrackScale(const std::vector<double>& along, const std::vector<double>& distances,
+                        RelationStats* stats) {
+  const double total = std::accumulate(distances.begin(), distances.end(), 0.0);
+  if (!(total > 0.0)) return;
+  const double scale = std::accumulate(along.begin(), along.end(), 0.0) / total;
+  double scatter = 0.0;
+  for (std::size_t i = 0; i < along.size(); ++i) {
+    const double residual = along[i] - scale * distances[i];
+    scatter += residual * residual;
+  }
+  stats->along_track_scale = scale;
+  stats->along_track_scale_error = std::sqrt(scatter) / total;
+  stats->along_track_count = static_cast<int>(along.size());
 }
 
 }  // namespace
@@ -107,8 +125,7 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
                                       const std::vector<Pose2D>& estimated, const std::vector<bool>& valid,
                                       double max_span) {
   RelationStats stats;
-  std::vector<double> trans_errors, rot_errors_deg;
-  double along = 0.0, reference_distance = 0.0;
+  std::vector<double> trans_errors, rot_errors_deg, along, reference_distances;
   for (std::size_t k = 0; k < relations.size(); ++k) {
     const Relation& relation = relations[k];
     if (!withinSpan(relation, max_span)) continue;
@@ -120,15 +137,15 @@ RelationStats evaluateRelativeMotions(const std::vector<Relation>& relations,
     const Pose2D residual = relativePose(relation.motion, estimated[k]);
     const double distance = relation.motion.translationNorm();
     if (distance >= RelationStats::kScaleMinDistance) {
-      along += (estimated[k].x * relation.motion.x + estimated[k].y * relation.motion.y) / distance;
-      reference_distance += distance;
+      along.push_back((estimated[k].x * relation.motion.x + estimated[k].y * relation.motion.y) / distance);
+      reference_distances.push_back(distance);
     }
     trans_errors.push_back(residual.translationNorm());
     rot_errors_deg.push_back(std::abs(normalizeAngle(residual.theta)) * kRadToDeg);
   }
   stats.count = static_cast<int>(trans_errors.size());
   if (stats.count == 0) return stats;
-  if (reference_distance > 0.0) stats.along_track_scale = along / reference_distance;
+  setAlongTrackScale(along, reference_distances, &stats);
   // Two passes (mean, then spread) so tiny spreads are not lost to cancellation.
   const auto moments = [](const std::vector<double>& values, double* mean, double* std_dev, double* sq_mean) {
     double sum = 0.0, sq_sum = 0.0;

@@ -58,8 +58,12 @@ void printStatsRows(std::FILE* out, const char* label, const hglasm::RelationSta
   std::fprintf(out, "\n  %-9s %13s | sq %.6f m2  %9.4f deg2", "", "", laser.trans_sq_mean,
                laser.rot_sq_mean_deg);
   if (has_wheel) std::fprintf(out, " | sq %.6f m2  %9.4f deg2", wheel.trans_sq_mean, wheel.rot_sq_mean_deg);
-  std::fprintf(out, "\n  %-9s %13s | along-track scale %.4f      ", "", "", laser.along_track_scale);
-  if (has_wheel) std::fprintf(out, " | along-track scale %.4f", wheel.along_track_scale);
+  std::fprintf(out, "\n  %-9s %13s | along-track scale %.4f +- %.4f (%d)", "", "", laser.along_track_scale,
+               laser.along_track_scale_error, laser.along_track_count);
+  if (has_wheel) {
+    std::fprintf(out, " | along-track scale %.4f +- %.4f", wheel.along_track_scale,
+                 wheel.along_track_scale_error);
+  }
   std::fprintf(out, "\n");
 }
 
@@ -383,19 +387,19 @@ void printSummary(std::FILE* out, const std::string& preset, const EvaluationRun
       "wheel_all_r=%.3f wheel_short_t=%.4f wheel_short_r=%.3f laser_frame_short_t=%.4f "
       "laser_frame_short_r=%.3f calibration=%.3f worst_leap=%.3f time_offset=%.3f resets=%d keyframes=%d "
       "short_t_median=%.4f short_r_median=%.3f wheel_short_t_median=%.4f wheel_short_r_median=%.3f "
-      "short_scale=%.4f wheel_short_scale=%.4f all_scale=%.4f wheel_all_scale=%.4f timing_ms=%.1f "
-      "wheel_timing_ms=%.1f turn_scale_pct=%.2f wheel_turn_scale_pct=%.2f laser_offset_x=%.4f "
-      "laser_offset_y=%.4f\n",
+      "short_scale=%.4f short_scale_error=%.4f wheel_short_scale=%.4f all_scale=%.4f wheel_all_scale=%.4f "
+      "timing_ms=%.1f wheel_timing_ms=%.1f turn_scale_pct=%.2f wheel_turn_scale_pct=%.2f "
+      "laser_offset_x=%.4f laser_offset_y=%.4f\n",
       preset.c_str(), scans, run.fallbacks, scans ? 100.0 * run.fallbacks / scans : 0.0, total.median,
       total.p99, total.max, r.laser_all.trans_mean, r.laser_all.rot_mean_deg, r.laser_short.trans_mean,
       r.laser_short.rot_mean_deg, r.wheel_all.trans_mean, r.wheel_all.rot_mean_deg, r.wheel_short.trans_mean,
       r.wheel_short.rot_mean_deg, r.laser_frame_short.trans_mean, r.laser_frame_short.rot_mean_deg,
       r.calibration.mean_sq_mahalanobis, r.worst_leap_ratio, run.time_offset, run.resets, run.keyframes,
       r.laser_short.trans_median, r.laser_short.rot_median_deg, r.wheel_short.trans_median,
-      r.wheel_short.rot_median_deg, r.laser_short.along_track_scale, r.wheel_short.along_track_scale,
-      r.laser_all.along_track_scale, r.wheel_all.along_track_scale, 1e3 * r.laser_timing.offset,
-      1e3 * r.wheel_timing.offset, 1e2 * r.laser_timing.turn_scale, 1e2 * r.wheel_timing.turn_scale,
-      learned.laser_offset.x(), learned.laser_offset.y());
+      r.wheel_short.rot_median_deg, r.laser_short.along_track_scale, r.laser_short.along_track_scale_error,
+      r.wheel_short.along_track_scale, r.laser_all.along_track_scale, r.wheel_all.along_track_scale,
+      1e3 * r.laser_timing.offset, 1e3 * r.wheel_timing.offset, 1e2 * r.laser_timing.turn_scale,
+      1e2 * r.wheel_timing.turn_scale, learned.laser_offset.x(), learned.laser_offset.y());
 }
 
 }  // namespace hglasm_odometry

@@ -91,20 +91,30 @@ TEST(Relations, MeanStdAndSquaresOfDifferentErrors) {
 
 TEST(Relations, AlongTrackScaleIsTheDistanceEstimatedAlongTheReferencesOverTheirs) {
   // 10 % too far along x, and a sideways error that does not count along the track; a relation that
-  // hardly moves (0.2 m) is left out of the scale.
+  // hardly moves (5 cm) is left out of the scale.
   std::vector<StampedPose> estimate;
   for (int i = 0; i <= 10; ++i) estimate.push_back({static_cast<double>(i), Pose2D(1.1 * i, 0.05 * i, 0.0)});
   const std::vector<Relation> relations = {{0.0, 1.0, Pose2D(1.0, 0.0, 0.0)},
                                            {2.0, 5.0, Pose2D(3.0, 0.0, 0.0)},
-                                           {6.0, 7.0, Pose2D(0.2, 0.0, 0.0)}};
-  EXPECT_NEAR(evaluateRelations(relations, estimate, 0.0).along_track_scale, 1.1, 1e-12);
+                                           {6.0, 7.0, Pose2D(0.05, 0.0, 0.0)}};
+  const RelationStats uniform = evaluateRelations(relations, estimate, 0.0);
+  EXPECT_NEAR(uniform.along_track_scale, 1.1, 1e-12);
+  EXPECT_EQ(uniform.along_track_count, 2);
+  EXPECT_NEAR(uniform.along_track_scale_error, 0.0, 1e-12);  // every relation 10 % too far: no scatter
   // One that falls short by half: (1.1 + 3.3 + 0.5 * 2) / (1 + 3 + 2).
   estimate.push_back({20.0, Pose2D(0.0, 0.0, 0.0)});
   estimate.push_back({21.0, Pose2D(1.0, 0.0, 0.0)});
   std::vector<Relation> more = relations;
   more.push_back({20.0, 21.0, Pose2D(2.0, 0.0, 0.0)});
-  EXPECT_NEAR(evaluateRelations(more, estimate, 0.0).along_track_scale, (1.1 + 3.3 + 1.0) / 6.0, 1e-12);
-  EXPECT_EQ(evaluateRelations({{6.0, 7.0, Pose2D(0.2, 0.0, 0.0)}}, estimate, 0.0).along_track_scale, 0.0);
+  const RelationStats mixed = evaluateRelations(more, estimate, 0.0);
+  const double scale = (1.1 + 3.3 + 1.0) / 6.0;
+  EXPECT_NEAR(mixed.along_track_scale, scale, 1e-12);
+  // The scatter of each relation's distance along the track about the scale's share of it.
+  const double scatter =
+      std::pow(1.1 - scale * 1.0, 2) + std::pow(3.3 - scale * 3.0, 2) + std::pow(1.0 - scale * 2.0, 2);
+  EXPECT_NEAR(mixed.along_track_scale_error, std::sqrt(scatter) / 6.0, 1e-12);
+  EXPECT_EQ(mixed.along_track_count, 3);
+  EXPECT_EQ(evaluateRelations({{6.0, 7.0, Pose2D(0.05, 0.0, 0.0)}}, estimate, 0.0).along_track_scale, 0.0);
 }
 
 TEST(Relations, RotationalErrorIsWrappedAndAbsolute) {

@@ -40,7 +40,14 @@ struct RelationStats {
   /// summed, over the reference distances summed. 1 is unbiased; below 1 the estimate falls short (a scan
   /// that prefers "no motion" along a featureless corridor), above it overshoots. 0 without such relations.
   double along_track_scale = 0.0;
-  static constexpr double kScaleMinDistance = 0.5;  ///< metres
+  /// Its standard error (the relations' scatter about the scale, as a ratio estimator's) and the relations
+  /// it rests on.
+  double along_track_scale_error = 0.0;
+  int along_track_count = 0;
+  /// Metres: well below most relations' motion, so that leaving out those the reference puts below it does
+  /// not select the relations whose reference happens to move farther (at 0.5 m aces kept 18 of its 1178
+  /// short relations, and the scale of both estimates read 0.92; from 0.1 m 1081 of them, 1.00).
+  static constexpr double kScaleMinDistance = 0.1;
 };
 
 /// Index of the pose of `trajectory` (sorted by stamp) whose stamp is nearest to `stamp` if within
