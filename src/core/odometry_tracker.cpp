@@ -249,9 +249,10 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
                                    matcher_.match(scan, h.prior.mean, population_out, &diagnostics.search,
                                                   options_.fusion ? &h.prior : nullptr),
                                    h.prior);
-  // An IMU's rotation does not slip with the wheels: its prior is left as predicted. Without fusion the
+  // A slip is the wheels': a constant velocity's guess has its own noise model and nothing that slips, and
+  // an IMU's rotation does not slip with the wheels; those priors are left as predicted. Without fusion the
   // match never had the prior.
-  if (options_.fusion && prior.informative && !prediction.rotation_from_imu) {
+  if (options_.fusion && prediction.source == PredictionSource::kOdometry && !prediction.rotation_from_imu) {
     refineIfSlipped(scan, scan_judge, prediction, h, &tight, &diagnostics);
   }
   // A prediction in doubt: the preset's whole box is searched under the second hypothesis.

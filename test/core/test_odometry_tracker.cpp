@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -522,6 +523,26 @@ TEST(OdometryTracker, WheelsThatSlipNowAndThenAreCorrectedNotCarriedOn) {
       EXPECT_GT(without, 2.0 * with_mixture) << "the mechanism: without it the slips are carried on";
     }
   }
+}
+
+TEST(OdometryTracker, AConstantVelocitysGuessIsNotTakenForSlippingWheels) {
+  // No wheels: each scan is predicted at the velocity of the last ones, which is wrong by a few of its
+  // sigmas every time the robot starts or stops. The slip mixture weighs the wheels' faults; a velocity's
+  // guess has its own noise model and no wheels to slip, so its prior is never softened.
+  const Path stop_and_go = [](double t) {
+    const double moving = std::min(t, 1.0) + std::clamp(t - 2.0, 0.0, 1.0);  // stands still from 1 s to 2 s
+    return hglasm_test::rawPose(1.5 * moving, 0.0, 0.0);
+  };
+  Robot robot(withoutOdometry(), stop_and_go);
+  int constant_velocity = 0;
+  for (int i = 0; i <= 35; ++i) {
+    const TrackerUpdate update = robot.step(0.1 * i);
+    expectSane(update);
+    if (update.diagnostics.prediction == PredictionSource::kConstantVelocity) ++constant_velocity;
+    EXPECT_EQ(update.diagnostics.prior_weight, 1.0) << "scan " << i;
+    hglasm_test::expectPoseNear(update.pose, robot.truth(0.1 * i), 0.02, hglasm_test::deg(0.5), "scan");
+  }
+  EXPECT_GT(constant_velocity, 30);
 }
 
 TEST(OdometryTracker, EmptyScansWithoutOdometryKeepTheConstantVelocity) {
