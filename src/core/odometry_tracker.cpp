@@ -250,8 +250,9 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
                                                   options_.fusion ? &h.prior : nullptr),
                                    h.prior);
   // A slip is the wheels': a constant velocity's guess has its own noise model and nothing that slips, and
-  // an IMU's rotation does not slip with the wheels; those priors are left as predicted. Without fusion the
-  // match never had the prior.
+  // an IMU's rotation does not slip with the wheels; those priors are left as predicted. (Wheels read a
+  // little past their newest sample are still the wheels', their extrapolation's uncertainty added.)
+  // Without fusion the match never had the prior.
   if (options_.fusion && prediction.source == PredictionSource::kOdometry && !prediction.rotation_from_imu) {
     refineIfSlipped(scan, scan_judge, prediction, h, &tight, &diagnostics);
   }

@@ -46,7 +46,7 @@ bool headingAt(const std::vector<StampedPose>& trajectory, double stamp, double*
 }
 
 /// The ratio of the sums and its standard error: the residuals of the relations about the scale times
-/// their distances, as a ratio estimator's.
+/// their distances, as a ratio estimator's (n / (n - 1) for the scale fitted; none from one relation).
 void setAlongTrackScale(const std::vector<double>& along, const std::vector<double>& distances,
                         RelationStats* stats) {
   const double total = std::accumulate(distances.begin(), distances.end(), 0.0);
@@ -57,8 +57,9 @@ void setAlongTrackScale(const std::vector<double>& along, const std::vector<doub
     const double residual = along[i] - scale * distances[i];
     scatter += residual * residual;
   }
+  const double n = static_cast<double>(along.size());
   stats->along_track_scale = scale;
-  stats->along_track_scale_error = std::sqrt(scatter) / total;
+  stats->along_track_scale_error = n > 1.0 ? std::sqrt(scatter * n / (n - 1.0)) / total : 0.0;
   stats->along_track_count = static_cast<int>(along.size());
 }
 

@@ -61,8 +61,8 @@ void printStatsRows(std::FILE* out, const char* label, const hglasm::RelationSta
   std::fprintf(out, "\n  %-9s %13s | along-track scale %.4f +- %.4f (%d)", "", "", laser.along_track_scale,
                laser.along_track_scale_error, laser.along_track_count);
   if (has_wheel) {
-    std::fprintf(out, " | along-track scale %.4f +- %.4f", wheel.along_track_scale,
-                 wheel.along_track_scale_error);
+    std::fprintf(out, " | along-track scale %.4f +- %.4f (%d)", wheel.along_track_scale,
+                 wheel.along_track_scale_error, wheel.along_track_count);
   }
   std::fprintf(out, "\n");
 }

@@ -109,12 +109,17 @@ TEST(Relations, AlongTrackScaleIsTheDistanceEstimatedAlongTheReferencesOverTheir
   const RelationStats mixed = evaluateRelations(more, estimate, 0.0);
   const double scale = (1.1 + 3.3 + 1.0) / 6.0;
   EXPECT_NEAR(mixed.along_track_scale, scale, 1e-12);
-  // The scatter of each relation's distance along the track about the scale's share of it.
+  // The scatter of each relation's distance along the track about the scale's share of it, n / (n - 1).
   const double scatter =
       std::pow(1.1 - scale * 1.0, 2) + std::pow(3.3 - scale * 3.0, 2) + std::pow(1.0 - scale * 2.0, 2);
-  EXPECT_NEAR(mixed.along_track_scale_error, std::sqrt(scatter) / 6.0, 1e-12);
+  EXPECT_NEAR(mixed.along_track_scale_error, std::sqrt(scatter * 3.0 / 2.0) / 6.0, 1e-12);
   EXPECT_EQ(mixed.along_track_count, 3);
   EXPECT_EQ(evaluateRelations({{6.0, 7.0, Pose2D(0.05, 0.0, 0.0)}}, estimate, 0.0).along_track_scale, 0.0);
+  // From 0.1 m on a relation counts; one alone gives a scale but no spread.
+  const RelationStats single = evaluateRelations({{6.0, 7.0, Pose2D(0.1, 0.0, 0.0)}}, estimate, 0.0);
+  EXPECT_NEAR(single.along_track_scale, 11.0, 1e-9);  // the estimate moves 1.1 m of the reference's 0.1 m
+  EXPECT_EQ(single.along_track_count, 1);
+  EXPECT_EQ(single.along_track_scale_error, 0.0);
 }
 
 TEST(Relations, RotationalErrorIsWrappedAndAbsolute) {

@@ -40,8 +40,9 @@ struct RelationStats {
   /// summed, over the reference distances summed. 1 is unbiased; below 1 the estimate falls short (a scan
   /// that prefers "no motion" along a featureless corridor), above it overshoots. 0 without such relations.
   double along_track_scale = 0.0;
-  /// Its standard error (the relations' scatter about the scale, as a ratio estimator's) and the relations
-  /// it rests on.
+  /// Its standard error (the relations' scatter about the scale, as a ratio estimator's; 0 from fewer than
+  /// two) and the relations it rests on. The relations are taken as independent: where they overlap in
+  /// time (the benchmark's do) it is a lower bound.
   double along_track_scale_error = 0.0;
   int along_track_count = 0;
   /// Metres: well below most relations' motion, so that leaving out those the reference puts below it does
