@@ -17,8 +17,15 @@ double likelihoodWeight(double independent_points, std::size_t points, double ev
   return weight / evidence_scale;
 }
 
-ScanJudge::ScanJudge(const LookupTable& table, const Scan& scan, double weight, double outlier)
-    : table_(&table), scan_(&scan), weight_(weight), outlier_(outlier) {
+ScanJudge::ScanJudge(const LookupTable& table, const Scan& scan, double weight, double outlier) {
+  reset(table, scan, weight, outlier);
+}
+
+void ScanJudge::reset(const LookupTable& table, const Scan& scan, double weight, double outlier) {
+  table_ = &table;
+  scan_ = &scan;
+  weight_ = weight;
+  outlier_ = outlier;
   points_.assign(scan.points);
 }
 

@@ -68,10 +68,7 @@ class Codec {
   double low_[3];
 };
 
-struct Individual {
-  std::uint64_t chromosome = 0;
-  std::uint32_t fitness = 0;
-};
+using Individual = GeneticIndividual;
 
 /// Latin hypercube: each gene's range is cut into one slice per individual and every slice is used once,
 /// so the first generation covers every heading of a +-pi box (uniform draws leave gaps that the GA then
@@ -128,7 +125,7 @@ SearchEffort sanitised(SearchEffort effort) {
 class Evolution {
  public:
   Evolution(const GeneticOptions& options, const FitnessStages& stages, const Codec& codec,
-            const SearchEffort& effort, std::mt19937_64& rng, int* evaluations)
+            const SearchEffort& effort, std::mt19937_64& rng, int* evaluations, GeneticScratch* scratch)
       : options_(options),
         stages_(stages),
         codec_(codec),
@@ -145,8 +142,12 @@ class Evolution {
         evaluations_(evaluations),
         random_member_(0, effort.population - 1),
         random_cut_(1, codec.totalBits() - 1),
-        population_(effort.population),
-        offspring_(effort.population) {}
+        population_(scratch->population),
+        offspring_(scratch->offspring),
+        slices_(scratch->slices) {
+    population_.assign(static_cast<std::size_t>(population_size_), Individual{});
+    offspring_.assign(static_cast<std::size_t>(population_size_), Individual{});
+  }
 
   /// One run; its final population, scored on the fine fitness.
   const std::vector<Individual>& run() {
@@ -233,8 +234,9 @@ class Evolution {
   std::uniform_real_distribution<double> unit_{0.0, 1.0};
   std::uniform_int_distribution<int> random_member_;
   std::uniform_int_distribution<int> random_cut_;
-  std::vector<Individual> population_, offspring_;
-  std::vector<int> slices_;
+  std::vector<Individual>& population_;
+  std::vector<Individual>& offspring_;
+  std::vector<int>& slices_;
   const PoseFitness* scoring_ = nullptr;
 };
 
@@ -288,8 +290,8 @@ PreAlignResult GeneticAligner::align(const FitnessStages& stages, const Pose2D& 
   result.evaluations = 1;
 
   const Codec codec(effort.box, guess, options_.bits_per_gene);
-  Evolution evolution(options_, stages, codec, effort, rng_, &result.evaluations);
-  std::vector<Individual> best_run_population;
+  Evolution evolution(options_, stages, codec, effort, rng_, &result.evaluations, &scratch_);
+  std::vector<Individual>& best_run_population = scratch_.best_run;
   std::uint32_t best_run_fitness = 0;
   for (int run = 0; run < effort.runs; ++run) {
     const std::vector<Individual>& population = evolution.run();

@@ -127,8 +127,11 @@ void NoiseLearner::accumulate(const Eigen::Vector3d& innovation,
 }
 
 void NoiseLearner::add(const NoiseSample& sample) {
+  // A vector, not a deque: its memory is reused once the window is full (samples are a few hundred bytes).
+  const std::size_t window = static_cast<std::size_t>(std::max(1, options_.lags)) + 1;
+  if (chain_.size() >= window)
+    chain_.erase(chain_.begin(), chain_.end() - static_cast<std::ptrdiff_t>(window - 1));
   chain_.push_back(sample);
-  while (static_cast<int>(chain_.size()) > std::max(1, options_.lags) + 1) chain_.pop_front();
   if (chain_.size() < 2 || !(options_.learn_wheels || options_.learn_scan)) return;
   const double forget = std::exp2(-1.0 / std::max(1.0, options_.half_life));
   normal_ *= forget;

@@ -242,7 +242,7 @@ bool OdometryTracker::matchScan(const Scan& scan, const MotionPrediction& predic
   LeapHypotheses h = leap_detector_.hypotheses(prior.mean, prior.covariance,
                                                boxVariances(wide_search.box, options_.search.sigmas));
   h.map_frame = local_map_.frame();
-  const ScanJudge scan_judge = judge(scan);
+  const ScanJudge& scan_judge = judge(scan);
   diagnostics.search =
       prior.informative ? searchAround(options_.matcher.genetic, options_.search, h.covariance) : wide_search;
   MatchCandidate tight = candidate(scan_judge,
@@ -307,12 +307,13 @@ void OdometryTracker::record(const LeapVerdict& verdict, TrackerUpdate* update) 
   diagnostics.weakest_direction = match.scan_directions.weakestDirection();
 }
 
-ScanJudge OdometryTracker::judge(const Scan& scan) const {
+const ScanJudge& OdometryTracker::judge(const Scan& scan) {
   // The scan's likelihood counts its independent points only, as its information does, and is tempered
   // by as much as the learned noise says the scan overstates its information.
   const double weight =
       likelihoodWeight(options_.matcher.mbicp.independent_points, scan.size(), learner_.scanEvidenceScale());
-  return ScanJudge(judgingTable(local_map_), scan, weight, options_.leap.likelihood_outlier);
+  scan_judge_.reset(judgingTable(local_map_), scan, weight, options_.leap.likelihood_outlier);
+  return scan_judge_;
 }
 
 MatchCandidate OdometryTracker::candidate(const ScanJudge& judge, const MatchResult& match,

@@ -28,8 +28,12 @@ double likelihoodWeight(double independent_points, std::size_t points, double ev
 /// the scan and the table stay unchanged.
 class ScanJudge {
  public:
+  /// Judges nothing (every figure 0) until reset.
+  ScanJudge() = default;
   /// `weight`: of the scan's likelihood (likelihoodWeight); `outlier`: the likelihood field's outlier share.
   ScanJudge(const LookupTable& table, const Scan& scan, double weight, double outlier);
+  /// Judges `scan` against `table` from now on (both must outlive the judging), in the memory of the last.
+  void reset(const LookupTable& table, const Scan& scan, double weight, double outlier);
 
   /// The cells the points hit / (255 * points): 1 = every point on the map; 0 without a table or points.
   double fitnessRatio(const Pose2D& pose) const;
@@ -41,13 +45,13 @@ class ScanJudge {
   double freeSpaceLogLikelihood(const Pose2D& pose) const;
 
  private:
-  bool usable() const { return !table_->empty() && !scan_->empty(); }
+  bool usable() const { return table_ && scan_ && !table_->empty() && !scan_->empty(); }
 
-  const LookupTable* table_;
-  const Scan* scan_;
+  const LookupTable* table_ = nullptr;
+  const Scan* scan_ = nullptr;
   FitnessPoints points_;  // the scan's finite points, prepared once for every pose judged
-  double weight_;
-  double outlier_;
+  double weight_ = 0.0;
+  double outlier_ = 0.0;
 };
 
 /// How well accepted matches usually fit the map: the mean and variance of their fitness ratios,

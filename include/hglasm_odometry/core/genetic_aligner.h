@@ -107,6 +107,19 @@ struct FitnessStages {
   double max_fitness = 0.0;   ///< fitness of a perfect fit (for fitness_ratio); 0: ratio 0
 };
 
+/// One chromosome of the GA and its fitness.
+struct GeneticIndividual {
+  std::uint64_t chromosome = 0;
+  std::uint32_t fitness = 0;
+};
+
+/// The populations one alignment evolves, kept between alignments so that matching allocates nothing
+/// once they have grown to the largest search's size.
+struct GeneticScratch {
+  std::vector<GeneticIndividual> population, offspring, best_run;
+  std::vector<int> slices;
+};
+
 /// Not thread-safe per instance (it owns its random generator); separate instances are independent.
 class GeneticAligner {
  public:
@@ -140,6 +153,7 @@ class GeneticAligner {
   std::mt19937_64 rng_;
   std::vector<Eigen::Vector2d> subset_;  // scratch: the points the fitness uses
   FitnessPoints prepared_;               // scratch: the same, prepared for the table
+  GeneticScratch scratch_;
 };
 
 }  // namespace hglasm

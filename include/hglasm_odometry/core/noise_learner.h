@@ -4,8 +4,8 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <deque>
 #include <string>
+#include <vector>
 
 #include "hglasm_odometry/core/motion_model.h"
 #include "hglasm_odometry/core/pose2d.h"
@@ -99,7 +99,7 @@ class NoiseLearner {
   void solve();
 
   NoiseLearnerOptions options_;
-  std::deque<NoiseSample> chain_;
+  std::vector<NoiseSample> chain_;
   Vector scales_ = Vector::Ones();
   Matrix normal_ = Matrix::Zero();  // exponentially forgotten normal equations of the moment fit
   Vector rhs_ = Vector::Zero();
