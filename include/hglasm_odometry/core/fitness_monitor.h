@@ -24,8 +24,8 @@ const LookupTable& judgingTable(const LocalMap& map);
 /// no more; <= 0: all of them), divided by how many times the scan overstates its evidence.
 double likelihoodWeight(double independent_points, std::size_t points, double evidence_scale);
 
-/// One scan judged at any pose (the local map's frame) on a judging table. Holds references: lives while
-/// the scan and the table stay unchanged.
+/// One scan judged at any pose (the local map's frame) on a judging table. Holds references: the scan and
+/// the table must stay unchanged until the next reset.
 class ScanJudge {
  public:
   /// Judges nothing (every figure 0) until reset.

@@ -250,7 +250,8 @@ class OdometryTracker {
                  TrackerUpdate* update, Estimate* estimate);
   /// The leap test's verdict and the chosen match, into the update.
   void record(const LeapVerdict& verdict, TrackerUpdate* update) const;
-  /// The scan against the local map's fine table, in one judge rebound at every call (its memory reused).
+  /// The scan against the local map's fine table, in one judge rebound at every call (its memory reused):
+  /// the reference is valid until the next call, and while the scan and the map stay unchanged.
   const ScanJudge& judge(const Scan& scan);
   MatchCandidate candidate(const ScanJudge& judge, const MatchResult& match, const PosePrior& prior) const;
   /// The new pose and its covariances from the chosen match.
@@ -290,7 +291,7 @@ class OdometryTracker {
   SensorLearner learner_;
   LeapDetector leap_detector_;
   FitnessMonitor fitness_;
-  ScanJudge scan_judge_;  // judge()'s
+  ScanJudge scan_judge_;  // judge()'s, rebound at every call
   KeyframePolicy keyframes_;
   Pose2D laser_mount_;
   Eigen::Vector2d applied_laser_offset_ = Eigen::Vector2d::Zero();  // m, base frame
