@@ -4,7 +4,8 @@
 # before a change and the build after it) run alternately, round by round, so that all see the same load.
 #
 # usage: scripts/node_cpu.sh [-d DEVEL]... [-b BAG]... [-n ROUNDS] [-r RATE] [-s] [-p] [-o OUT_DIR]
-#   -d  a devel space (default build/devel); evaluate is the first one's
+#   -d  a devel space (default build/devel) whose node names its worker thread "laser_odometry"; evaluate
+#       is the first one's
 #   -b  bags (default bags/fr079_slice.bag bags/aces_slice.bag)
 #   -n  rounds (default 3); -r the player's rate (default 3); -s the standalone node instead of the nodelet
 #   -p  also record each node run with perf (OUT_DIR/*.perf; perf report -i F --sort sym)
@@ -14,8 +15,9 @@
 # /diagnostics the only subscriptions to the node's outputs. Process: every thread of the node's process,
 # per scan. Self: the node's own "CPU per scan, mean" (diagnostics; conversion, matching and publishing).
 # Wake: the worker's wake-ups (times scheduled in) per scan.
-# evaluate: its "total per scan (CPU)" (conversion and OdometryPipeline::processScan, one thread, as fast as
-# it goes). All in ms.
+# evaluate: its "total per scan (CPU)" (conversion and OdometryPipeline::processScan, one thread), as fast as
+# it goes and paced (--pace RATE: each scan processed when the player would deliver it, the core idle in
+# between as the worker's is). All in ms.
 # Run it niced on a shared machine: nice -n 10 scripts/node_cpu.sh ...
 set -euo pipefail
 
@@ -30,8 +32,8 @@ while getopts "d:b:n:r:spo:h" option; do
     s) standalone=true ;;
     p) perf=true ;;
     o) out_dir="$OPTARG" ;;
-    h) sed -n '2,18p' "$0"; exit 0 ;;
-    *) sed -n '2,18p' "$0" >&2; exit 2 ;;
+    h) sed -n '2,21p' "$0"; exit 0 ;;
+    *) sed -n '2,21p' "$0" >&2; exit 2 ;;
   esac
 done
 ((${#devels[@]})) || devels=("$ROOT/build/devel")
@@ -41,14 +43,16 @@ export PATH=/usr/bin:$PATH ROS_HOSTNAME=localhost ROS_HOME="$out_dir/ros_home"
 node=/laser_odometry_manager
 $standalone && node=/laser_odometry
 
-# Prints "mean median p99" of evaluate's total per scan (CPU).
-evaluate_cpu() {  # BAG LOG
+# Prints "mean median p99" of evaluate's total per scan (CPU); further arguments go to evaluate.
+evaluate_cpu() {  # BAG LOG [ARGS...]
+  local bag="$1" log="$2"
+  shift 2
   (
     set +u
     source "${devels[0]}/setup.bash"
-    "${devels[0]}/lib/hglasm_odometry/evaluate" --bag "$1" --quiet >"$2" 2>&1
-  ) || { echo "node_cpu: evaluate failed on $1, see $2" >&2; exit 1; }
-  awk '/total per scan \(CPU\)/ {print $9, $6, $7}' "$2"
+    "${devels[0]}/lib/hglasm_odometry/evaluate" --bag "$bag" --quiet "$@" >"$log" 2>&1
+  ) || { echo "node_cpu: evaluate failed on $bag, see $log" >&2; exit 1; }
+  awk '/total per scan \(CPU\)/ {print $9, $6, $7}' "$log"
 }
 
 # Plays BAG through the node of DEVEL; prints the monitor's line.
@@ -84,32 +88,37 @@ EOF
   tail -1 "$log"
 }
 
-printf "%-12s %5s %-2s | %-20s | %-20s | %-20s | %s\n" bag round d "evaluate mean/med/p99" \
-  "worker mean/med/p99" "process, self, wake" "worker/evaluate mean median p99"
+printf "%-12s %5s %-2s | %-20s | %-20s | %-20s | %-19s | %s\n" bag round d "evaluate mean/med/p99" \
+  "paced mean/med/p99" "worker mean/med/p99" "process, self, wake" "worker/evaluate mean med p99, /paced mean"
 for bag in "${bags[@]}"; do
   name=$(basename "$bag" .bag)
   rows="$out_dir/${name}_rows.txt"
   : >"$rows"
   for round in $(seq 1 "$rounds"); do
     evaluate=$(evaluate_cpu "$bag" "$out_dir/${name}_evaluate_$round.log")
+    paced=$(evaluate_cpu "$bag" "$out_dir/${name}_paced_$round.log" --pace "$rate")
     for d in "${!devels[@]}"; do
       line=$(node_cpu "${devels[$d]}" "$bag" "$out_dir/${name}_node${d}_$round.log")
       worker=$(awk '{print $6, $8, $10, $12, $14, $16}' <<<"$line")
-      echo "$d $evaluate $worker" >>"$rows"
-      # columns: d, evaluate mean median p99, worker mean median p99, process mean, the node's own mean,
-      # the worker's wake-ups
+      echo "$d $evaluate $paced $worker" >>"$rows"
+      # columns: d, evaluate mean median p99, paced mean median p99, worker mean median p99, process mean,
+      # the node's own mean, the worker's wake-ups
     done
   done
-  awk -v name="${name%_slice}" -v n="${#devels[@]}" '{
-      printf "%-12s %5d %-2s | %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f | %6.3f %6.3f %5.2f | %5.2f %5.2f %5.2f\n",
-        name, int((NR - 1) / n) + 1, $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $5 / $2, $6 / $3, $7 / $4
-      for (i = 2; i <= 10; ++i) sum[$1, i] += $i
-      seen[$1] = 1
+  awk -v name="${name%_slice}" -v n="${#devels[@]}" '
+    function row(label, d, v) {
+      printf "%-12s %5s %-2s | %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f | %6.3f %6.3f %5.2f | %5.2f %5.2f %5.2f %5.2f\n",
+        name, label, d, v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13],
+        v[8] / v[2], v[9] / v[3], v[10] / v[4], v[8] / v[5]
+    }
+    {
+      for (i = 2; i <= 13; ++i) { v[i] = $i; sum[$1, i] += $i }
+      row(int((NR - 1) / n) + 1, $1, v)
     } END {
-      for (d = 0; d < n; ++d) printf "%-12s %5s %-2s | %6.3f %6.3f %6.3f | %6.3f %6.3f %6.3f | %6.3f %6.3f %5.2f | %5.2f %5.2f %5.2f  (all rounds)\n",
-        name, "all", d, sum[d, 2] * n / NR, sum[d, 3] * n / NR, sum[d, 4] * n / NR, sum[d, 5] * n / NR,
-        sum[d, 6] * n / NR, sum[d, 7] * n / NR, sum[d, 8] * n / NR, sum[d, 9] * n / NR, sum[d, 10] * n / NR,
-        sum[d, 5] / sum[d, 2], sum[d, 6] / sum[d, 3], sum[d, 7] / sum[d, 4]
+      for (d = 0; d < n; ++d) {
+        for (i = 2; i <= 13; ++i) v[i] = sum[d, i] * n / NR
+        row("all", d, v)
+      }
     }' "$rows"
 done
 echo "devels:"

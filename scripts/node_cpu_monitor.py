@@ -6,7 +6,9 @@ the standalone node) through the master, subscribes /tf (which a robot always ha
 odom -> base transform per scan processed) and, on each of the node's transforms, reads every thread's CPU
 time from /proc/PID/task/*/schedstat. The difference between two consecutive transforms is one whole cycle
 of the worker: waiting, taking the queued inputs, conversion, matching, publishing and bookkeeping. The
-worker is the thread that used the most CPU over the run; its wake-ups are the times it was scheduled in.
+worker is the thread named "laser_odometry" (the node names it); its wake-ups are the times it was scheduled
+in. A build that does not name it is refused: the thread of the most CPU is not always the worker (replaying
+with --clock, roscpp's poll thread takes 100 /clock messages a second and outspends a light worker).
 Prints one line of `key value` pairs.
 """
 import argparse
@@ -45,6 +47,22 @@ def loaded_library(pid, name, wait=30.0):
         if time.time() > deadline:
             return ""
         time.sleep(0.2)
+
+
+WORKER_NAME = "laser_odometry"
+
+
+def worker_tid(pid):
+    """The thread of `pid` named WORKER_NAME, or None."""
+    task_dir = "/proc/%d/task" % pid
+    for tid in os.listdir(task_dir):
+        try:
+            with open("%s/%s/comm" % (task_dir, tid)) as f:
+                if f.read().strip() == WORKER_NAME:
+                    return int(tid)
+        except OSError:
+            pass
+    return None
 
 
 def thread_cpu_ns(pid):
@@ -151,7 +169,10 @@ def main():
 
     first, last = samples[0], samples[-1]
     totals = {tid: last[tid][0] - first.get(tid, (0, 0))[0] for tid in last}
-    worker = max(totals, key=totals.get)
+    worker = worker_tid(pid)
+    if worker is None or worker not in first or worker not in last:
+        sys.exit("node_cpu_monitor: no thread named %s in %s (a build that does not name its worker)"
+                 % (WORKER_NAME, args.node))
     per_scan = sorted((b[worker][0] - a.get(worker, b[worker])[0]) * 1e-6 for a, b in zip(samples, samples[1:]))
     cycles = len(samples) - 1
     wakeups = (last[worker][1] - first[worker][1]) / cycles

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <utility>
 
+#include <pthread.h>
+
 #include <geometry_msgs/TransformStamped.h>
 
 #include "hglasm_odometry/core/timing.h"
@@ -24,6 +26,7 @@ constexpr int kOdomSubscriberQueue = 200;
 constexpr int kImuSubscriberQueue = 1000;
 constexpr double kTfRetrySeconds = 0.05;   // wall time between tf lookups while a mount is missing
 constexpr double kStaleWarnPeriod = 10.0;  // seconds between warnings about inputs stamped out of order
+constexpr char kWorkerThreadName[] = "laser_odometry";
 
 InputQueueLimits queueLimits(const LaserOdometryOptions& options) {
   InputQueueLimits limits;
@@ -198,6 +201,9 @@ void LaserOdometry::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
 // ------------------------------------------------------------------------------------------ the worker
 
 void LaserOdometry::workerLoop() {
+  // Named so that top -H, perf and scripts/node_cpu_monitor.py tell it from roscpp's threads (at most 15
+  // characters).
+  pthread_setname_np(pthread_self(), kWorkerThreadName);
   while (std::optional<sensor_msgs::LaserScanConstPtr> scan = queue_.waitForScan()) {
     const sensor_msgs::LaserScan& msg = **scan;
     if (!laserMountReady(msg.header.frame_id)) {

@@ -1,8 +1,10 @@
 #include "hglasm_odometry/tools/bag_replay.h"
 
 #include <algorithm>
+#include <chrono>
 #include <deque>
 #include <limits>
+#include <thread>
 
 #include "hglasm_odometry/core/timing.h"
 
@@ -19,9 +21,10 @@ class Replay {
 
   ReplayCounts run() {
     const bool use_odometry = pipeline_->options().prediction.use_odometry;
+    wall_start_ = std::chrono::steady_clock::now();
+    if (!data_.arrivals.empty()) first_receive_time_ = receiveTime(data_.arrivals.front());
     for (const BagArrival& arrival : data_.arrivals) {
-      const double now =
-          arrival.scan ? data_.scans[arrival.index].receive_time : data_.odometry[arrival.index].receive_time;
+      const double now = receiveTime(arrival);
       timeOut(now);
       if (arrival.scan) {
         enqueue(&data_.scans[arrival.index], now);
@@ -72,6 +75,20 @@ class Replay {
     }
   }
 
+  double receiveTime(const BagArrival& arrival) const {
+    return arrival.scan ? data_.scans[arrival.index].receive_time
+                        : data_.odometry[arrival.index].receive_time;
+  }
+
+  /// With options_.pace_rate, sleeps until the scan would have arrived at a live node.
+  void pace(const BagScan& scan) const {
+    if (!(options_.pace_rate > 0.0)) return;
+    const std::chrono::duration<double> since_start((scan.receive_time - first_receive_time_) /
+                                                    options_.pace_rate);
+    std::this_thread::sleep_until(
+        wall_start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(since_start));
+  }
+
   double sweep(const BagScan& scan) const {
     return hglasm::scanSweepTime(scan.ranges.time_increment, scan.ranges.ranges.size(),
                                  pipeline_->conversion());
@@ -81,6 +98,7 @@ class Replay {
     ReplayedScan replayed;
     replayed.scan = waiting_.front();
     waiting_.pop_front();
+    pace(*replayed.scan);
     const double start = hglasm::threadCpuMs();
     replayed.update = pipeline_->processScan(replayed.scan->stamp, replayed.scan->ranges);
     replayed.cpu_ms = hglasm::threadCpuMs() - start;
@@ -95,6 +113,8 @@ class Replay {
   const std::function<void(const ReplayedScan&)>& on_scan_;
   std::deque<const BagScan*> waiting_;
   double wait_start_ = -std::numeric_limits<double>::infinity();
+  std::chrono::steady_clock::time_point wall_start_;
+  double first_receive_time_ = 0.0;
   ReplayCounts counts_;
 };
 

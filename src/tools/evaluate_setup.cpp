@@ -1,6 +1,7 @@
 #include "hglasm_odometry/tools/evaluate_setup.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <cstdio>
 #include <cstdlib>
@@ -35,6 +36,9 @@ const char kUsage[] =
     "  --min-scan-interval S   skip scans stamped less than S s after the last processed one\n"
     "  --laser-mount X,Y,YAW   base -> laser (m, m, rad) instead of the bag's tf\n"
     "  --max-scans N           process only the first N scans\n"
+    "  --pace RATE             process each scan no earlier than rosbag play --rate RATE delivers it to\n"
+    "                          a live node (the CPU per scan of a core that idles between scans, as\n"
+    "                          the node's worker does; scripts/node_cpu.sh); default: as fast as it goes\n"
     "  --odom-stamp-shift S    move every wheel-odometry message S s later (stamp and arrival): wheels that\n"
     "                          lag the scans by S s, for the time-offset estimation (the wheel baseline\n"
     "                          is read S s later too, so it stays the bag's)\n"
@@ -105,11 +109,16 @@ ArgumentParser::Result parseEvaluateArguments(const std::vector<std::string>& ar
     return args->override_mount;
   });
   parser.addOption("--min-scan-interval", &args->min_scan_interval);
+  parser.addOption("--pace", &args->pace_rate);
   parser.addOption("--max-span", &args->short_span);
   const ArgumentParser::Result result = parser.parse(arguments);
   if (result != ArgumentParser::Result::kOk) return result;
   if (args->bag.empty()) {
     parser.fail("--bag is required");
+    return ArgumentParser::Result::kError;
+  }
+  if (!(args->pace_rate >= 0.0) || !std::isfinite(args->pace_rate)) {
+    parser.fail("--pace must be a playback rate > 0 (or 0: as fast as it goes)");
     return ArgumentParser::Result::kError;
   }
   if (!args->relation_errors.empty() && args->relations.empty()) {

@@ -95,13 +95,14 @@ void scoreAtEveryScan(const BagData& data, EvaluationRun* run) {
 
 EvaluationRun runEvaluation(const BagData& data, const LaserOdometryOptions& nodelet,
                             const hglasm::TrackerOptions& tracker, double min_scan_interval,
-                            std::size_t warnings_kept) {
+                            std::size_t warnings_kept, double pace_rate) {
   EvaluationRun run;
   hglasm::OdometryPipeline pipeline(tracker, nodelet.odometry_wait > 0.0);
   setLaserMount(data, &pipeline);
   ReplayOptions replay;
   replay.odometry_wait = nodelet.odometry_wait;
   replay.queue_size = static_cast<std::size_t>(nodelet.queue_size);
+  replay.pace_rate = pace_rate;
   const auto on_scan = [&](const ReplayedScan& replayed) { record(replayed, warnings_kept, &run); };
   if (min_scan_interval > 0.0) {
     BagData thinned = data;

@@ -40,6 +40,10 @@ TEST(EvaluateSetup, ParsesTheCommandLine) {
   EXPECT_EQ(args.relation_errors, "e.txt");
   EXPECT_FALSE(args.direct_pairs);
   EXPECT_FALSE(args.config_given);
+  EXPECT_EQ(args.pace_rate, 0.0);
+  EvaluateArguments paced;
+  ASSERT_EQ(parse({"--bag", "b.bag", "--pace", "3"}, &paced), ArgumentParser::Result::kOk);
+  EXPECT_EQ(paced.pace_rate, 3.0);
 }
 
 TEST(EvaluateSetup, RefusesAMissingBagAndABadMount) {
@@ -48,6 +52,8 @@ TEST(EvaluateSetup, RefusesAMissingBagAndABadMount) {
   EvaluateArguments errors_alone;
   EXPECT_EQ(parse({"--bag", "b.bag", "--relation-errors", "e.txt"}, &errors_alone),
             ArgumentParser::Result::kError);
+  EvaluateArguments pace;
+  EXPECT_EQ(parse({"--bag", "b.bag", "--pace", "-1"}, &pace), ArgumentParser::Result::kError);
   EvaluateArguments mount;
   EXPECT_EQ(parse({"--bag", "b.bag", "--laser-mount", "0.1,0.2"}, &mount), ArgumentParser::Result::kError);
   hglasm::Pose2D pose;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -76,6 +77,45 @@ TEST(EvaluationRun, IsTheNodeletsPipelineReplayed) {
     EXPECT_EQ(run().trajectory[i].stamp, expected[i].stamp);
     EXPECT_EQ(run().trajectory[i].pose.x, expected[i].pose.x) << i;
     EXPECT_EQ(run().trajectory[i].pose.theta, expected[i].pose.theta) << i;
+  }
+}
+
+/// The trajectory of replaying `data` with `replay` (the slice's options).
+std::vector<hglasm::StampedPose> replayed(const BagData& data, const ReplayOptions& replay) {
+  hglasm::OdometryPipeline pipeline(slice().options.tracker, slice().options.odometry_wait > 0.0);
+  setLaserMount(data, &pipeline);
+  std::vector<hglasm::StampedPose> poses;
+  replayBag(data, &pipeline, replay, [&poses](const ReplayedScan& scan) {
+    if (scan.update.tracker.published) poses.push_back({scan.scan->stamp, scan.update.tracker.pose});
+  });
+  return poses;
+}
+
+TEST(EvaluationRun, APacedReplayTakesTheBagsTimeOverItsRateAndMatchesTheSame) {
+  BagData data = slice().data;
+  data.arrivals.resize(60);
+  const BagArrival& front = data.arrivals.front();
+  const double first =
+      front.scan ? data.scans[front.index].receive_time : data.odometry[front.index].receive_time;
+  double last_scan = first;
+  for (const BagArrival& arrival : data.arrivals) {
+    if (arrival.scan) last_scan = std::max(last_scan, data.scans[arrival.index].receive_time);
+  }
+  ASSERT_GT(last_scan - first, 1.0);
+  ReplayOptions replay;
+  replay.odometry_wait = slice().options.odometry_wait;
+  replay.queue_size = static_cast<std::size_t>(slice().options.queue_size);
+  const std::vector<hglasm::StampedPose> unpaced = replayed(data, replay);
+
+  replay.pace_rate = (last_scan - first) / 0.3;  // the last scan 0.3 s of wall time after the first
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<hglasm::StampedPose> paced = replayed(data, replay);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GE(wall, 0.3);  // a lower bound: sleeping never ends early
+  ASSERT_EQ(paced.size(), unpaced.size());
+  for (std::size_t i = 0; i < paced.size(); ++i) {
+    EXPECT_EQ(paced[i].pose.x, unpaced[i].pose.x) << i;
+    EXPECT_EQ(paced[i].pose.theta, unpaced[i].pose.theta) << i;
   }
 }
 

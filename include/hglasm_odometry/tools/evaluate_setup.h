@@ -28,6 +28,7 @@ struct EvaluateArguments {
   std::string relation_errors;  ///< --relation-errors: per-relation errors of both trajectories
   bool use_odometry = true;
   double min_scan_interval = 0.0;
+  double pace_rate = 0.0;  ///< --pace: process the scans no faster than rosbag play at this rate
   bool override_mount = false;
   hglasm::Pose2D laser_mount;
   std::size_t max_scans = 0;
