@@ -92,6 +92,14 @@ bool OdometryPipeline::inputsReadyFor(double stamp, double sweep) const {
   return dropped || (wheelsReadyFor(stamp) && imuReadyFor(stamp + std::max(0.0, sweep)));
 }
 
+OdometryPipeline::AwaitedStamps OdometryPipeline::awaitedFor(double stamp, double sweep) const {
+  AwaitedStamps awaited;
+  if (!wheelsReadyFor(stamp)) awaited.wheels = stamp + tracker_.odometryTimeOffset();
+  const double sweep_end = stamp + std::max(0.0, sweep);
+  if (!imuReadyFor(sweep_end)) awaited.imu = sweep_end;
+  return awaited;
+}
+
 void OdometryPipeline::inputsWaitTimedOut(double stamp, double sweep) {
   if (!wheelsReadyFor(stamp)) wheels_.stalled = true;
   if (!imuReadyFor(stamp + std::max(0.0, sweep))) imu_.stalled = true;

@@ -186,6 +186,11 @@ TEST(OdometryPipeline, TheImuIsWaitedForToTheEndOfTheSweep) {
   ASSERT_EQ(pipeline.addImu(1.1, 0.0), SampleVerdict::kTaken);
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0, 0.1));
   EXPECT_FALSE(pipeline.inputsReadyFor(1.0, 0.2));
+  // What a live wait wakes for: the IMU sample at the sweep's end, no wheel sample (they are there).
+  const OdometryPipeline::AwaitedStamps awaited = pipeline.awaitedFor(1.0, 0.2);
+  EXPECT_EQ(awaited.wheels, std::numeric_limits<double>::infinity());
+  EXPECT_DOUBLE_EQ(awaited.imu, 1.2);
+  EXPECT_EQ(pipeline.awaitedFor(1.3, 0.0).wheels, 1.3);
   pipeline.inputsWaitTimedOut(1.0, 0.2);
   EXPECT_TRUE(pipeline.imuStalled());
   EXPECT_FALSE(pipeline.odometryStalled());
@@ -433,8 +438,11 @@ TEST(OdometryPipeline, LateWheelsAreWaitedForByTheirTimeOffset) {
   EXPECT_EQ(pipeline.odometryTimeOffset(), 0.3);
   ASSERT_EQ(pipeline.addOdometry(1.0, Pose2D()), SampleVerdict::kTaken);
   EXPECT_FALSE(pipeline.inputsReadyFor(1.0)) << "their pose of 1.0 s comes stamped 1.3 s";
+  EXPECT_DOUBLE_EQ(pipeline.awaitedFor(1.0).wheels, 1.3);
+  EXPECT_EQ(pipeline.awaitedFor(1.0).imu, std::numeric_limits<double>::infinity()) << "no use_imu";
   ASSERT_EQ(pipeline.addOdometry(1.3, Pose2D()), SampleVerdict::kTaken);
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0));
+  EXPECT_EQ(pipeline.awaitedFor(1.0).wheels, std::numeric_limits<double>::infinity());
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <future>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -63,7 +64,7 @@ TEST(InputQueue, HoldScanWaitsItsTimeWhateverArrives) {
   std::thread producer([&queue] {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
     queue.pushScan(2, 0.0);
-    queue.pushOdometry(1.0);
+    queue.pushOdometry(1.0, 1.0);
   });
   EXPECT_TRUE(queue.holdScan(1, 0.05));
   producer.join();
@@ -73,8 +74,8 @@ TEST(InputQueue, HoldScanWaitsItsTimeWhateverArrives) {
 TEST(InputQueue, TakeMovesEverythingInOrderAndClearsIt) {
   Queue queue(limits(5, 3));
   Queue::Inputs inputs;
-  for (double stamp : {1.0, 2.0, 3.0, 4.0}) queue.pushOdometry(stamp);  // bound 3: 1.0 dropped
-  queue.pushImu(0.5f);
+  for (double stamp : {1.0, 2.0, 3.0, 4.0}) queue.pushOdometry(stamp, stamp);  // bound 3: 1.0 dropped
+  queue.pushImu(0.5f, 0.5);
   ASSERT_TRUE(queue.take(&inputs));
   ASSERT_EQ(inputs.odometry.size(), 3u);
   EXPECT_EQ(inputs.odometry[0], 2.0);
@@ -90,7 +91,7 @@ TEST(InputQueue, TakeMovesEverythingInOrderAndClearsIt) {
   EXPECT_TRUE(inputs.odometry.empty());
   EXPECT_TRUE(inputs.imu.empty());
   // The queue keeps its bound whichever storage it got back.
-  for (double stamp : {5.0, 6.0, 7.0, 8.0}) queue.pushOdometry(stamp);
+  for (double stamp : {5.0, 6.0, 7.0, 8.0}) queue.pushOdometry(stamp, stamp);
   queue.take(&inputs);
   ASSERT_EQ(inputs.odometry.size(), 3u);
   EXPECT_EQ(inputs.odometry.front(), 6.0);
@@ -121,7 +122,7 @@ TEST(InputQueue, WaitForInputsWakesForASampleOrARequest) {
   const auto far = Clock::now() + std::chrono::seconds(10);
   auto woken = std::async(std::launch::async, [&queue, far] { return queue.waitForInputs(far); });
   std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  queue.pushOdometry(1.0);
+  queue.pushOdometry(1.0, 1.0);
   ASSERT_EQ(woken.wait_for(std::chrono::seconds(5)), std::future_status::ready);
   EXPECT_TRUE(woken.get());
 
@@ -145,8 +146,49 @@ TEST(InputQueue, WaitForInputsTimesOutWhenOnlyScansArrive) {
 
 TEST(InputQueue, InputsQueuedBeforeTheWaitEndItAtOnce) {
   Queue queue(limits(5));
-  queue.pushImu(1.0f);
+  queue.pushImu(1.0f, 1.0);
   EXPECT_TRUE(queue.waitForInputs(Clock::now() + std::chrono::seconds(10)));
+}
+
+TEST(InputQueue, AWaitForAStampSleepsThroughTheSamplesBeforeIt) {
+  Queue queue(limits(5));
+  AwaitedStamps awaited;
+  awaited.odometry = std::numeric_limits<double>::infinity();  // the wheels are not waited for
+  awaited.imu = 1.0;                                           // the IMU to the end of the sweep
+  const auto far = Clock::now() + std::chrono::seconds(10);
+  auto woken =
+      std::async(std::launch::async, [&queue, far, awaited] { return queue.waitForInputs(far, awaited); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (int i = 0; i < 9; ++i) queue.pushImu(0.0f, 0.1 * i);
+  queue.pushOdometry(2.0, 2.0);
+  // Sleeping through them: a worker woken by any of these would have returned by now.
+  EXPECT_EQ(woken.wait_for(std::chrono::milliseconds(50)), std::future_status::timeout);
+  queue.pushImu(0.0f, 1.0);
+  ASSERT_EQ(woken.wait_for(std::chrono::seconds(5)), std::future_status::ready);
+  EXPECT_TRUE(woken.get());
+  Queue::Inputs inputs;
+  queue.take(&inputs);
+  EXPECT_EQ(inputs.imu.size(), 10u);
+  EXPECT_EQ(inputs.odometry.size(), 1u);
+}
+
+TEST(InputQueue, AWaitForAStampEndsAtOnceForWhatIsQueuedAlreadyAndForASampleBackInTime) {
+  Queue queue(limits(5));
+  AwaitedStamps wheels;
+  wheels.odometry = 3.0;
+  wheels.imu = std::numeric_limits<double>::infinity();
+  queue.pushOdometry(3.5, 3.5);  // queued between the worker's take and its wait
+  EXPECT_TRUE(queue.waitForInputs(Clock::now() + std::chrono::seconds(10), wheels));
+  Queue::Inputs inputs;
+  queue.take(&inputs);
+  // Taken: the same wait now sleeps until its deadline.
+  EXPECT_FALSE(queue.waitForInputs(Clock::now() + std::chrono::milliseconds(20), wheels));
+  // A stamp before the last one (a restarted clock, a looped bag) is the worker's to judge.
+  queue.pushOdometry(0.1, 0.1);
+  EXPECT_TRUE(queue.waitForInputs(Clock::now() + std::chrono::seconds(10), wheels));
+  queue.take(&inputs);
+  queue.pushOdometry(0.2, std::numeric_limits<double>::quiet_NaN());
+  EXPECT_TRUE(queue.waitForInputs(Clock::now() + std::chrono::seconds(10), wheels));
 }
 
 TEST(InputQueue, StopEndsEveryWait) {
@@ -169,7 +211,7 @@ TEST(InputQueue, AWaitingWorkerGetsTheScan) {
   Queue queue(limits(5));
   auto scan = std::async(std::launch::async, [&queue] { return queue.waitForScan(); });
   std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  queue.pushOdometry(1.0);  // not what it waits for
+  queue.pushOdometry(1.0, 1.0);  // not what it waits for
   queue.pushScan(7, 0.0);
   ASSERT_EQ(scan.wait_for(std::chrono::seconds(5)), std::future_status::ready);
   EXPECT_EQ(scan.get(), 7);

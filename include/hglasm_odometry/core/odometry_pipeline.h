@@ -104,6 +104,14 @@ class OdometryPipeline {
   /// sweep. A scan the time policy will drop waits for nothing.
   bool inputsReadyFor(double stamp, double sweep = 0.0) const;
 
+  /// The stamps the wheels and the IMU must reach (a sample stamped at or after them) before a scan at
+  /// `stamp` may be processed; +infinity where that input is not waited for. What a live wait wakes for.
+  struct AwaitedStamps {
+    double wheels = std::numeric_limits<double>::infinity();
+    double imu = std::numeric_limits<double>::infinity();
+  };
+  AwaitedStamps awaitedFor(double stamp, double sweep = 0.0) const;
+
   /// A live wait for a scan at `stamp` timed out: the wheel odometry, the IMU or both (whichever had no
   /// sample at or after it) count as stalled until a sample of theirs arrives that the newest scan
   /// processed waited for: one that lags by more than the wait is not waited for at every scan.

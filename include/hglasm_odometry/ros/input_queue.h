@@ -1,15 +1,19 @@
 // What the subscription callbacks and services hand to the laser odometry's worker thread, and every wait of
 // that worker: one mutex and one condition variable. Producers only append (never wait on the worker's
-// matching) and wake the worker only for what it waits for (a scan, or the inputs a scan waits for), not
-// for every wheel or IMU sample. Each wait ends as soon as stop() is called, so unloading never waits out a
-// timeout. ROS-free: the element types are the caller's (message pointers in the node, plain values in the
-// tests).
+// matching) and wake the worker only for what it waits for (a scan, or the wheel or IMU sample that makes a
+// scan's inputs complete), not for every wheel or IMU sample: a 200 Hz IMU waited for to the end of a scan's
+// sweep would otherwise wake it a dozen times per scan. Each wait ends as soon as stop() is called, so
+// unloading never waits out a timeout. ROS-free: the element types are the caller's (message pointers in the
+// node, plain values in the tests).
 #pragma once
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <utility>
@@ -24,6 +28,14 @@ struct InputQueueLimits {
   std::size_t scans = 5;
   std::size_t odometry = 10000;  ///< only reached while the worker waits for tf (100 s at 100 Hz)
   std::size_t imu = 20000;       ///< 20 s at 1 kHz
+};
+
+/// What ends the worker's wait for a scan's inputs: a wheel (IMU) sample stamped at or after `odometry`
+/// (`imu`); +infinity: none of that kind is waited for, -infinity: any sample of it. A sample stamped before
+/// the previous one of its kind (a new timeline) or not at all (NaN) ends the wait too: the worker judges it.
+struct AwaitedStamps {
+  double odometry = -std::numeric_limits<double>::infinity();
+  double imu = -std::numeric_limits<double>::infinity();
 };
 
 /// The scan side of the queue, for the diagnostics.
@@ -65,8 +77,11 @@ class InputQueue {
     if (wake) wake_.notify_one();
   }
 
-  void pushOdometry(Odometry sample) { pushSample(&odometry_, std::move(sample)); }
-  void pushImu(Imu sample) { pushSample(&imu_, std::move(sample)); }
+  /// Queues a wheel (IMU) sample stamped `stamp` (seconds, the stamps' clock).
+  void pushOdometry(Odometry sample, double stamp) {
+    pushSample(&odometry_, &odometry_feed_, std::move(sample), stamp);
+  }
+  void pushImu(Imu sample, double stamp) { pushSample(&imu_, &imu_feed_, std::move(sample), stamp); }
 
   /// Restart from the origin at the next scan; replaces a requested pose.
   void requestReset() {
@@ -130,11 +145,13 @@ class InputQueue {
     return !stop_;
   }
 
-  /// Waits until a sample or a request is queued, or stop() (true), or until `deadline` (false).
-  bool waitForInputs(std::chrono::steady_clock::time_point deadline) {
+  /// Waits until a sample `awaited` asks for (queued since the last take() or arriving now) or a request is
+  /// queued, or stop() (true), or until `deadline` (false).
+  bool waitForInputs(std::chrono::steady_clock::time_point deadline, const AwaitedStamps& awaited = {}) {
     std::unique_lock<std::mutex> lock(mutex_);
     waiting_for_ = Wait::kInputs;
-    const bool woken = wake_.wait_until(lock, deadline, [this] { return stop_ || hasInputs(); });
+    awaited_ = awaited;
+    const bool woken = wake_.wait_until(lock, deadline, [this] { return stop_ || awaitedArrived(); });
     waiting_for_ = Wait::kStop;
     return woken;
   }
@@ -145,6 +162,8 @@ class InputQueue {
     std::lock_guard<std::mutex> lock(mutex_);
     odometry_.swapElements(inputs->odometry);
     imu_.swapElements(inputs->imu);
+    odometry_feed_.taken();
+    imu_feed_.taken();
     inputs->reset = std::exchange(reset_, false);
     inputs->pose = std::move(pose_);
     pose_.reset();
@@ -176,24 +195,48 @@ class InputQueue {
   /// What the worker waits for; anything else is only queued (stop() always wakes it).
   enum class Wait { kStop, kScan, kInputs };
 
+  /// The stamps of one kind of sample queued since the last take().
+  struct Feed {
+    double newest_queued = -std::numeric_limits<double>::infinity();
+    bool irregular = false;                                      ///< a stamp before the previous one, or NaN
+    double previous = -std::numeric_limits<double>::infinity();  ///< kept across takes
+
+    void push(double stamp) {
+      if (!(stamp >= previous)) irregular = true;
+      newest_queued = std::max(newest_queued, stamp);
+      if (!std::isnan(stamp)) previous = stamp;
+    }
+    void taken() {
+      newest_queued = -std::numeric_limits<double>::infinity();
+      irregular = false;
+    }
+    bool reaches(double awaited) const { return irregular || newest_queued >= awaited; }
+  };
+
   template <typename Sample>
-  void pushSample(RingBuffer<Sample>* samples, Sample sample) {
+  void pushSample(RingBuffer<Sample>* samples, Feed* feed, Sample sample, double stamp) {
     bool wake = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       samples->push_back(std::move(sample));
-      wake = waiting_for_ == Wait::kInputs;
+      feed->push(stamp);
+      wake = waiting_for_ == Wait::kInputs && awaitedArrived();
     }
     if (wake) wake_.notify_one();
   }
 
-  bool hasInputs() const { return !odometry_.empty() || !imu_.empty() || reset_ || pose_.has_value(); }
+  bool awaitedArrived() const {
+    return reset_ || pose_.has_value() || (!odometry_.empty() && odometry_feed_.reaches(awaited_.odometry)) ||
+           (!imu_.empty() && imu_feed_.reaches(awaited_.imu));
+  }
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   RingBuffer<Scan> scans_;
   RingBuffer<Odometry> odometry_;
   RingBuffer<Imu> imu_;
+  Feed odometry_feed_, imu_feed_;
+  AwaitedStamps awaited_;
   std::uint64_t received_scans_ = 0;
   std::uint32_t dropped_scans_ = 0;
   std::optional<double> last_arrival_;

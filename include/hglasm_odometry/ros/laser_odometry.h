@@ -58,8 +58,10 @@ class LaserOdometry {
   // ---- spinner threads: they only queue (and log what they were asked)
   void subscribe();
   void scanCallback(const sensor_msgs::LaserScanConstPtr& msg);
-  void odomCallback(const nav_msgs::OdometryConstPtr& msg) { queue_.pushOdometry(msg); }
-  void imuCallback(const sensor_msgs::ImuConstPtr& msg) { queue_.pushImu(msg); }
+  void odomCallback(const nav_msgs::OdometryConstPtr& msg) {
+    queue_.pushOdometry(msg, msg->header.stamp.toSec());
+  }
+  void imuCallback(const sensor_msgs::ImuConstPtr& msg) { queue_.pushImu(msg, msg->header.stamp.toSec()); }
   bool resetCallback(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool setPoseCallback(SetPose::Request& request, SetPose::Response& response);
   void setPoseTopicCallback(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg);
