@@ -87,13 +87,10 @@ bool OdometryPipeline::imuReadyFor(double stamp) const {
   return !tracker_.options().prediction.use_imu || !wait_for_inputs_ || imu_.readyFor(stamp);
 }
 
-bool OdometryPipeline::inputsReadyFor(double stamp, double sweep) const {
-  const bool dropped = stamp < scan_order_.newest() && !scan_order_.behind(stamp);
-  return dropped || (wheelsReadyFor(stamp) && imuReadyFor(stamp + std::max(0.0, sweep)));
-}
-
-OdometryPipeline::AwaitedStamps OdometryPipeline::awaitedFor(double stamp, double sweep) const {
+AwaitedStamps OdometryPipeline::awaitedFor(double stamp, double sweep) const {
   AwaitedStamps awaited;
+  const bool dropped = stamp < scan_order_.newest() && !scan_order_.behind(stamp);
+  if (dropped) return awaited;  // the time policy drops it: it waits for nothing
   if (!wheelsReadyFor(stamp)) awaited.wheels = stamp + tracker_.odometryTimeOffset();
   const double sweep_end = stamp + std::max(0.0, sweep);
   if (!imuReadyFor(sweep_end)) awaited.imu = sweep_end;

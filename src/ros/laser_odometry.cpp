@@ -226,8 +226,7 @@ bool LaserOdometry::waitForInputs(double stamp, double sweep) {
       std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wait));
   while (takeInputs()) {
     if (pipeline_.inputsReadyFor(stamp, sweep)) return true;
-    const hglasm::OdometryPipeline::AwaitedStamps awaited = pipeline_.awaitedFor(stamp, sweep);
-    if (!queue_.waitForInputs(deadline, {awaited.wheels, awaited.imu})) {
+    if (!queue_.waitForInputs(deadline, pipeline_.awaitedFor(stamp, sweep))) {
       if (!takeInputs()) return false;
       // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
       pipeline_.inputsWaitTimedOut(stamp, sweep);

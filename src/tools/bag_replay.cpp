@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <limits>
 #include <thread>
@@ -80,11 +81,11 @@ class Replay {
                         : data_.odometry[arrival.index].receive_time;
   }
 
-  /// With options_.pace_rate, sleeps until the scan would have arrived at a live node.
-  void pace(const BagScan& scan) const {
-    if (!(options_.pace_rate > 0.0)) return;
-    const std::chrono::duration<double> since_start((scan.receive_time - first_receive_time_) /
-                                                    options_.pace_rate);
+  /// With options_.pace_rate, sleeps until `now` (bag seconds: when a live worker turns to the scan, its
+  /// inputs there or its wait over) comes at that playback rate.
+  void pace(double now) const {
+    if (!(options_.pace_rate > 0.0) || !std::isfinite(now)) return;
+    const std::chrono::duration<double> since_start((now - first_receive_time_) / options_.pace_rate);
     std::this_thread::sleep_until(
         wall_start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(since_start));
   }
@@ -98,7 +99,7 @@ class Replay {
     ReplayedScan replayed;
     replayed.scan = waiting_.front();
     waiting_.pop_front();
-    pace(*replayed.scan);
+    pace(now);
     const double start = hglasm::threadCpuMs();
     replayed.update = pipeline_->processScan(replayed.scan->stamp, replayed.scan->ranges);
     replayed.cpu_ms = hglasm::threadCpuMs() - start;

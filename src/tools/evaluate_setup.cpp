@@ -56,6 +56,8 @@ const char kUsage[] =
     "                          re-weighting of the two inputs serve the relations better than the fusion\n"
     "  --quiet                 no per-warning output\n";
 
+constexpr double kMinPaceRate = 0.01;  // slower, a bag's hours would overflow the wall clock's ticks
+
 bool exists(const std::string& path) { return std::ifstream(path).good(); }
 
 /// Whether every parameter of `tree` is `key` or below it (and there is one).
@@ -117,8 +119,8 @@ ArgumentParser::Result parseEvaluateArguments(const std::vector<std::string>& ar
     parser.fail("--bag is required");
     return ArgumentParser::Result::kError;
   }
-  if (!(args->pace_rate >= 0.0) || !std::isfinite(args->pace_rate)) {
-    parser.fail("--pace must be a playback rate > 0 (or 0: as fast as it goes)");
+  if (!(args->pace_rate == 0.0 || args->pace_rate >= kMinPaceRate) || !std::isfinite(args->pace_rate)) {
+    parser.fail("--pace must be a playback rate of at least 0.01 (or 0: as fast as it goes)");
     return ArgumentParser::Result::kError;
   }
   if (!args->relation_errors.empty() && args->relations.empty()) {

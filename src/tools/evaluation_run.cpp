@@ -103,6 +103,7 @@ EvaluationRun runEvaluation(const BagData& data, const LaserOdometryOptions& nod
   replay.odometry_wait = nodelet.odometry_wait;
   replay.queue_size = static_cast<std::size_t>(nodelet.queue_size);
   replay.pace_rate = pace_rate;
+  if (pace_rate > 0.0) replay.rate = pace_rate;  // the waits too are those of a node at that rate
   const auto on_scan = [&](const ReplayedScan& replayed) { record(replayed, warnings_kept, &run); };
   if (min_scan_interval > 0.0) {
     BagData thinned = data;

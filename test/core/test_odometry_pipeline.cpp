@@ -187,7 +187,7 @@ TEST(OdometryPipeline, TheImuIsWaitedForToTheEndOfTheSweep) {
   EXPECT_TRUE(pipeline.inputsReadyFor(1.0, 0.1));
   EXPECT_FALSE(pipeline.inputsReadyFor(1.0, 0.2));
   // What a live wait wakes for: the IMU sample at the sweep's end, no wheel sample (they are there).
-  const OdometryPipeline::AwaitedStamps awaited = pipeline.awaitedFor(1.0, 0.2);
+  const hglasm::AwaitedStamps awaited = pipeline.awaitedFor(1.0, 0.2);
   EXPECT_EQ(awaited.wheels, std::numeric_limits<double>::infinity());
   EXPECT_DOUBLE_EQ(awaited.imu, 1.2);
   EXPECT_EQ(pipeline.awaitedFor(1.3, 0.0).wheels, 1.3);
@@ -428,6 +428,42 @@ TEST(OdometryPipeline, TimePolicyAScanClockThatJumpsBackRestartsAndForgetsTheOld
   }
   EXPECT_NEAR(pipeline.pose().x, straightAt(0.5).x - straightAt(0.0).x, 0.01);
   EXPECT_EQ(pipeline.inputCounts().jumps_back, 1u);
+}
+
+TEST(OdometryPipeline, AScanIsReadyExactlyWhenItAwaitsNothing) {
+  // What a live wait wakes for (awaitedFor) and when it may go on (inputsReadyFor) are one rule.
+  TrackerOptions options;
+  options.prediction.use_imu = true;
+  OdometryPipeline pipeline(options);
+  const auto check = [&pipeline](double stamp, double sweep, bool ready, const char* state) {
+    const hglasm::AwaitedStamps awaited = pipeline.awaitedFor(stamp, sweep);
+    EXPECT_EQ(pipeline.inputsReadyFor(stamp, sweep), ready) << state;
+    EXPECT_EQ(awaited.nothing(), ready) << state;
+  };
+  check(1.0, 0.1, true, "no samples yet");
+  ASSERT_EQ(pipeline.addOdometry(0.9, Pose2D()), SampleVerdict::kTaken);
+  ASSERT_EQ(pipeline.addImu(0.9, 0.0), SampleVerdict::kTaken);
+  check(1.0, 0.1, false, "both behind");
+  EXPECT_EQ(pipeline.awaitedFor(1.0, 0.1).wheels, 1.0);
+  EXPECT_DOUBLE_EQ(pipeline.awaitedFor(1.0, 0.1).imu, 1.1);
+  ASSERT_EQ(pipeline.addOdometry(1.2, Pose2D()), SampleVerdict::kTaken);
+  check(1.0, 0.1, false, "the IMU behind");
+  EXPECT_EQ(pipeline.awaitedFor(1.0, 0.1).wheels, std::numeric_limits<double>::infinity());
+  pipeline.inputsWaitTimedOut(1.0, 0.1);
+  check(1.0, 0.1, true, "the IMU stalled");
+  ASSERT_EQ(pipeline.addImu(1.2, 0.0), SampleVerdict::kTaken);
+  check(1.0, 0.1, true, "both there");
+  const PipelineUpdate first = pipeline.processScan(1.0, straightScan(1.0, Pose2D()));
+  ASSERT_FALSE(first.tracker.stale);
+  check(0.95, 0.5, true, "a scan the time policy drops (its sweep's IMU not there)");
+  check(1.05, 0.5, false, "the same sweep after the last scan");
+  check(5.0, 0.1, false, "wheels and IMU behind a later scan");
+  TrackerOptions wheels_off = options;
+  wheels_off.prediction.use_odometry = false;
+  wheels_off.prediction.use_imu = false;
+  OdometryPipeline off(wheels_off);
+  ASSERT_EQ(off.addOdometry(0.9, Pose2D()), SampleVerdict::kTaken);
+  EXPECT_TRUE(off.awaitedFor(5.0).nothing()) << "inputs not used are not awaited";
 }
 
 TEST(OdometryPipeline, LateWheelsAreWaitedForByTheirTimeOffset) {

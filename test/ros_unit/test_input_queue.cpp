@@ -150,17 +150,21 @@ TEST(InputQueue, InputsQueuedBeforeTheWaitEndItAtOnce) {
   EXPECT_TRUE(queue.waitForInputs(Clock::now() + std::chrono::seconds(10)));
 }
 
+/// Only the IMU awaited, to 1.0 s.
+hglasm::AwaitedStamps imuToOneSecond() {
+  hglasm::AwaitedStamps awaited;
+  awaited.imu = 1.0;
+  return awaited;
+}
+
 TEST(InputQueue, AWaitForAStampSleepsThroughTheSamplesBeforeIt) {
   Queue queue(limits(5));
-  AwaitedStamps awaited;
-  awaited.odometry = std::numeric_limits<double>::infinity();  // the wheels are not waited for
-  awaited.imu = 1.0;                                           // the IMU to the end of the sweep
   const auto far = Clock::now() + std::chrono::seconds(10);
   auto woken =
-      std::async(std::launch::async, [&queue, far, awaited] { return queue.waitForInputs(far, awaited); });
+      std::async(std::launch::async, [&queue, far] { return queue.waitForInputs(far, imuToOneSecond()); });
   std::this_thread::sleep_for(std::chrono::milliseconds(5));
   for (int i = 0; i < 9; ++i) queue.pushImu(0.0f, 0.1 * i);
-  queue.pushOdometry(2.0, 2.0);
+  queue.pushOdometry(2.0, 2.0);  // the wheels are not awaited
   // Sleeping through them: a worker woken by any of these would have returned by now.
   EXPECT_EQ(woken.wait_for(std::chrono::milliseconds(50)), std::future_status::timeout);
   queue.pushImu(0.0f, 1.0);
@@ -172,23 +176,33 @@ TEST(InputQueue, AWaitForAStampSleepsThroughTheSamplesBeforeIt) {
   EXPECT_EQ(inputs.odometry.size(), 1u);
 }
 
-TEST(InputQueue, AWaitForAStampEndsAtOnceForWhatIsQueuedAlreadyAndForASampleBackInTime) {
+TEST(InputQueue, AWaitForAStampEndsAtOnceForWhatIsQueuedAlreadyNotForWhatWasTaken) {
   Queue queue(limits(5));
-  AwaitedStamps wheels;
-  wheels.odometry = 3.0;
-  wheels.imu = std::numeric_limits<double>::infinity();
+  hglasm::AwaitedStamps wheels;
+  wheels.wheels = 3.0;
   queue.pushOdometry(3.5, 3.5);  // queued between the worker's take and its wait
   EXPECT_TRUE(queue.waitForInputs(Clock::now() + std::chrono::seconds(10), wheels));
   Queue::Inputs inputs;
   queue.take(&inputs);
-  // Taken: the same wait now sleeps until its deadline.
   EXPECT_FALSE(queue.waitForInputs(Clock::now() + std::chrono::milliseconds(20), wheels));
-  // A stamp before the last one (a restarted clock, a looped bag) is the worker's to judge.
+  // A sample back in time (a restarted clock) cannot complete the scan's inputs either.
   queue.pushOdometry(0.1, 0.1);
-  EXPECT_TRUE(queue.waitForInputs(Clock::now() + std::chrono::seconds(10), wheels));
-  queue.take(&inputs);
-  queue.pushOdometry(0.2, std::numeric_limits<double>::quiet_NaN());
-  EXPECT_TRUE(queue.waitForInputs(Clock::now() + std::chrono::seconds(10), wheels));
+  EXPECT_FALSE(queue.waitForInputs(Clock::now() + std::chrono::milliseconds(20), wheels));
+}
+
+TEST(InputQueue, ARequestOrStopEndsAWaitForAStamp) {
+  for (const char* ending : {"reset", "pose", "stop"}) {
+    Queue queue(limits(5));
+    const auto far = Clock::now() + std::chrono::seconds(10);
+    auto woken =
+        std::async(std::launch::async, [&queue, far] { return queue.waitForInputs(far, imuToOneSecond()); });
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (std::string(ending) == "reset") queue.requestReset();
+    if (std::string(ending) == "pose") queue.requestPose("p");
+    if (std::string(ending) == "stop") queue.stop();
+    ASSERT_EQ(woken.wait_for(std::chrono::seconds(5)), std::future_status::ready) << ending;
+    EXPECT_TRUE(woken.get()) << ending;
+  }
 }
 
 TEST(InputQueue, StopEndsEveryWait) {

@@ -54,6 +54,8 @@ TEST(EvaluateSetup, RefusesAMissingBagAndABadMount) {
             ArgumentParser::Result::kError);
   EvaluateArguments pace;
   EXPECT_EQ(parse({"--bag", "b.bag", "--pace", "-1"}, &pace), ArgumentParser::Result::kError);
+  EvaluateArguments crawl;
+  EXPECT_EQ(parse({"--bag", "b.bag", "--pace", "1e-12"}, &crawl), ArgumentParser::Result::kError);
   EvaluateArguments mount;
   EXPECT_EQ(parse({"--bag", "b.bag", "--laser-mount", "0.1,0.2"}, &mount), ArgumentParser::Result::kError);
   hglasm::Pose2D pose;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "hglasm_odometry/core/awaited_stamps.h"
 #include "hglasm_odometry/core/odometry_tracker.h"
 #include "hglasm_odometry/core/pose2d.h"
 #include "hglasm_odometry/core/scan.h"
@@ -102,14 +103,11 @@ class OdometryPipeline {
   /// wheels are waited for to `stamp` plus their time offset). The IMU is waited for to the end of the
   /// scan's sweep (`sweep` seconds after the stamp; scanSweepTime): de-skewing takes its turn during the
   /// sweep. A scan the time policy will drop waits for nothing.
-  bool inputsReadyFor(double stamp, double sweep = 0.0) const;
+  bool inputsReadyFor(double stamp, double sweep = 0.0) const { return awaitedFor(stamp, sweep).nothing(); }
 
   /// The stamps the wheels and the IMU must reach (a sample stamped at or after them) before a scan at
-  /// `stamp` may be processed; +infinity where that input is not waited for. What a live wait wakes for.
-  struct AwaitedStamps {
-    double wheels = std::numeric_limits<double>::infinity();
-    double imu = std::numeric_limits<double>::infinity();
-  };
+  /// `stamp` may be processed; +infinity where that input is not waited for (nothing, once it is ready).
+  /// What a live wait wakes for.
   AwaitedStamps awaitedFor(double stamp, double sweep = 0.0) const;
 
   /// A live wait for a scan at `stamp` timed out: the wheel odometry, the IMU or both (whichever had no

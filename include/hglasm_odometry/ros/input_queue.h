@@ -2,14 +2,13 @@
 // that worker: one mutex and one condition variable. Producers only append (never wait on the worker's
 // matching) and wake the worker only for what it waits for (a scan, or the wheel or IMU sample that makes a
 // scan's inputs complete), not for every wheel or IMU sample: a 200 Hz IMU waited for to the end of a scan's
-// sweep would otherwise wake it a dozen times per scan. Each wait ends as soon as stop() is called, so
+// sweep would otherwise wake it once per sample until then. Each wait ends as soon as stop() is called, so
 // unloading never waits out a timeout. ROS-free: the element types are the caller's (message pointers in the
 // node, plain values in the tests).
 #pragma once
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -18,6 +17,7 @@
 #include <optional>
 #include <utility>
 
+#include "hglasm_odometry/core/awaited_stamps.h"
 #include "hglasm_odometry/ros/ring_buffer.h"
 
 namespace hglasm_odometry {
@@ -28,14 +28,6 @@ struct InputQueueLimits {
   std::size_t scans = 5;
   std::size_t odometry = 10000;  ///< only reached while the worker waits for tf (100 s at 100 Hz)
   std::size_t imu = 20000;       ///< 20 s at 1 kHz
-};
-
-/// What ends the worker's wait for a scan's inputs: a wheel (IMU) sample stamped at or after `odometry`
-/// (`imu`); +infinity: none of that kind is waited for, -infinity: any sample of it. A sample stamped before
-/// the previous one of its kind (a new timeline) or not at all (NaN) ends the wait too: the worker judges it.
-struct AwaitedStamps {
-  double odometry = -std::numeric_limits<double>::infinity();
-  double imu = -std::numeric_limits<double>::infinity();
 };
 
 /// The scan side of the queue, for the diagnostics.
@@ -146,8 +138,10 @@ class InputQueue {
   }
 
   /// Waits until a sample `awaited` asks for (queued since the last take() or arriving now) or a request is
-  /// queued, or stop() (true), or until `deadline` (false).
-  bool waitForInputs(std::chrono::steady_clock::time_point deadline, const AwaitedStamps& awaited = {}) {
+  /// queued, or stop() (true), or until `deadline` (false). Samples stamped before the awaited stamps (a
+  /// new timeline's included) cannot make the scan's inputs complete: they are only queued.
+  bool waitForInputs(std::chrono::steady_clock::time_point deadline,
+                     const hglasm::AwaitedStamps& awaited = hglasm::AwaitedStamps::anySample()) {
     std::unique_lock<std::mutex> lock(mutex_);
     waiting_for_ = Wait::kInputs;
     awaited_ = awaited;
@@ -195,22 +189,13 @@ class InputQueue {
   /// What the worker waits for; anything else is only queued (stop() always wakes it).
   enum class Wait { kStop, kScan, kInputs };
 
-  /// The stamps of one kind of sample queued since the last take().
+  /// The newest stamp of one kind of sample queued since the last take().
   struct Feed {
     double newest_queued = -std::numeric_limits<double>::infinity();
-    bool irregular = false;                                      ///< a stamp before the previous one, or NaN
-    double previous = -std::numeric_limits<double>::infinity();  ///< kept across takes
 
-    void push(double stamp) {
-      if (!(stamp >= previous)) irregular = true;
-      newest_queued = std::max(newest_queued, stamp);
-      if (!std::isnan(stamp)) previous = stamp;
-    }
-    void taken() {
-      newest_queued = -std::numeric_limits<double>::infinity();
-      irregular = false;
-    }
-    bool reaches(double awaited) const { return irregular || newest_queued >= awaited; }
+    void push(double stamp) { newest_queued = std::max(newest_queued, stamp); }
+    void taken() { newest_queued = -std::numeric_limits<double>::infinity(); }
+    bool reaches(double awaited) const { return newest_queued >= awaited; }
   };
 
   template <typename Sample>
@@ -226,7 +211,7 @@ class InputQueue {
   }
 
   bool awaitedArrived() const {
-    return reset_ || pose_.has_value() || (!odometry_.empty() && odometry_feed_.reaches(awaited_.odometry)) ||
+    return reset_ || pose_.has_value() || (!odometry_.empty() && odometry_feed_.reaches(awaited_.wheels)) ||
            (!imu_.empty() && imu_feed_.reaches(awaited_.imu));
   }
 
@@ -236,7 +221,7 @@ class InputQueue {
   RingBuffer<Odometry> odometry_;
   RingBuffer<Imu> imu_;
   Feed odometry_feed_, imu_feed_;
-  AwaitedStamps awaited_;
+  hglasm::AwaitedStamps awaited_;
   std::uint64_t received_scans_ = 0;
   std::uint32_t dropped_scans_ = 0;
   std::optional<double> last_arrival_;

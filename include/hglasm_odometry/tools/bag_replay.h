@@ -20,9 +20,9 @@ struct ReplayOptions {
   double rate = 1.0;
   /// The nodelet's queue_size: scans waiting beyond it drop the oldest.
   std::size_t queue_size = 5;
-  /// > 0: each scan is processed no earlier (wall clock) than its receive time, counted from the bag's
-  /// first message, divided by this rate (rosbag play --rate): the idle time between scans a live node
-  /// has, after which its core runs cold (caches, TLB). 0: as fast as it goes.
+  /// > 0: each scan is processed no earlier (wall clock) than a live worker would turn to it (the bag's
+  /// receive times from its first message, divided by this rate, as `rate`): the idle time between scans a
+  /// live node has, after which its core runs cold (caches, TLB). 0: as fast as it goes.
   double pace_rate = 0.0;
 };
 
