@@ -8,8 +8,9 @@ time from /proc/PID/task/*/schedstat. The difference between two consecutive tra
 of the worker: waiting, taking the queued inputs, conversion, matching, publishing and bookkeeping. The
 worker is the thread named "laser_odometry" (the node names it; with several laser odometry nodelets in one
 manager, the first such thread found, so run one as scripts/node_cpu.sh does); its wake-ups are the times it
-was scheduled in. A build that does not name it is refused: the thread of the most CPU is not always the worker (replaying
-with --clock, roscpp's poll thread takes 100 /clock messages a second and outspends a light worker).
+was scheduled in. A build that does not name it is refused: the thread of the most CPU is not always the
+worker (replaying with --clock, roscpp's poll thread takes 100 /clock messages a second and outspends a
+light worker).
 Prints one line of `key value` pairs.
 """
 import argparse
