@@ -1,7 +1,8 @@
 // Replays a bag slice through the running laser odometry (nodelet or node, per the .test file) and checks
 // what it published: one odometry, one tf and one ~match per scan, stamped with the scan stamps, no NaN,
 // few fallbacks, the trajectory's accuracy against the slice's reference relations, and that the offline
-// pipeline (evaluate's) run over the same bag with the node's parameters gives the same trajectory.
+// pipeline (evaluate's) run over the same bag with the node's parameters gives the same trajectory; and that
+// the node's worker thread is named laser_odometry.
 //
 // Private parameters:
 //   bag (required)         the bag the player plays (read here for the scan stamps and wheel odometry)
@@ -30,6 +31,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -41,6 +44,7 @@
 #include <vector>
 
 #include <nav_msgs/Odometry.h>
+#include <ros/network.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -49,6 +53,7 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/SetBool.h>
 #include <tf2_msgs/TFMessage.h>
+#include <xmlrpcpp/XmlRpcClient.h>
 
 #include "hglasm_odometry/Match.h"
 #include "hglasm_odometry/core/odometry_buffer.h"
@@ -117,6 +122,39 @@ bool topicHasSubscriber(const std::string& topic) {
     if (static_cast<std::string>(subscribers[i][0]) == topic && subscribers[i][1].size() > 0) return true;
   }
   return false;
+}
+
+/// The names of the threads of the process of the node that publishes `topic` (it runs on this machine);
+/// empty when the master or the node does not answer.
+std::vector<std::string> threadNamesOfPublisher(const std::string& topic) {
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  if (!ros::master::execute("getSystemState", request, response, payload, false)) return {};
+  std::string node;
+  XmlRpc::XmlRpcValue& publishers = payload[0];
+  for (int i = 0; i < publishers.size() && node.empty(); ++i) {
+    if (static_cast<std::string>(publishers[i][0]) == topic && publishers[i][1].size() > 0) {
+      node = static_cast<std::string>(publishers[i][1][0]);
+    }
+  }
+  XmlRpc::XmlRpcValue lookup, uri;
+  lookup[0] = ros::this_node::getName();
+  lookup[1] = node;
+  if (node.empty() || !ros::master::execute("lookupNode", lookup, response, uri, false)) return {};
+  std::string host;
+  std::uint32_t port = 0;
+  if (!ros::network::splitURI(static_cast<std::string>(uri), host, port)) return {};
+  XmlRpc::XmlRpcClient client(host.c_str(), static_cast<int>(port), "/");
+  XmlRpc::XmlRpcValue caller(ros::this_node::getName()), pid_response;
+  if (!client.execute("getPid", caller, pid_response) || static_cast<int>(pid_response[0]) != 1) return {};
+  const int pid = static_cast<int>(pid_response[2]);
+  std::vector<std::string> names;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task")) {
+    std::ifstream comm(task.path() / "comm");
+    std::string name;
+    if (std::getline(comm, name)) names.push_back(name);
+  }
+  return names;
 }
 
 /// The private parameters (see the file comment).
@@ -295,6 +333,13 @@ TEST_F(OdometryReplay, PlayerStartedAndTheBagHasScans) {
   EXPECT_EQ(recording_->scan_stamps.size() - recording_->published_stamps.size(),
             static_cast<std::size_t>(recording_->settings.stale_scans))
       << "scans stamped before one played ahead of them";
+}
+
+TEST_F(OdometryReplay, TheWorkerThreadIsNamedForTopAndPerf) {
+  // scripts/node_cpu_monitor.py finds the worker by this name; top -H and perf show it.
+  const std::vector<std::string> names = threadNamesOfPublisher(recording_->settings.odom_topic);
+  ASSERT_FALSE(names.empty()) << "the process publishing " << recording_->settings.odom_topic;
+  EXPECT_EQ(std::count(names.begin(), names.end(), "laser_odometry"), 1);
 }
 
 TEST_F(OdometryReplay, OneOdometryPerScanStampedWithTheScanStamp) {
