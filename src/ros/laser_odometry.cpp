@@ -225,8 +225,9 @@ bool LaserOdometry::waitForInputs(double stamp, double sweep) {
       std::chrono::steady_clock::now() +
       std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wait));
   while (takeInputs()) {
-    if (pipeline_.inputsReadyFor(stamp, sweep)) return true;
-    if (!queue_.waitForInputs(deadline, pipeline_.awaitedFor(stamp, sweep))) {
+    const hglasm::AwaitedStamps awaited = pipeline_.awaitedFor(stamp, sweep);
+    if (awaited.nothing()) return true;  // inputsReadyFor
+    if (!queue_.waitForInputs(deadline, awaited)) {
       if (!takeInputs()) return false;
       // Odometry that stopped (or lags by more than the wait) is not waited for again until it moves.
       pipeline_.inputsWaitTimedOut(stamp, sweep);

@@ -62,7 +62,7 @@ int evaluate(const EvaluateArguments& args) {
   if (!readEvaluateInputs(args, nodelet.base_frame, &inputs, &error)) return fail(error, 1);
   const BagData& data = inputs.data;
   printInputs(stdout, args, inputs, nodelet.preset, options.prediction.use_odometry);
-  const EvaluationRun run = runEvaluation(data, nodelet, options, args.min_scan_interval, 20, args.pace_rate);
+  const EvaluationRun run = runEvaluation(data, nodelet, options, args.min_scan_interval, args.pace_rate);
   printRun(stdout, run, data.scans.back().stamp - data.scans.front().stamp, !args.quiet);
 
   const std::vector<hglasm::StampedPose> wheel = wheelTrajectory(data, args.odom_stamp_shift);

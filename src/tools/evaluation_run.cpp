@@ -94,8 +94,8 @@ void scoreAtEveryScan(const BagData& data, EvaluationRun* run) {
 }
 
 EvaluationRun runEvaluation(const BagData& data, const LaserOdometryOptions& nodelet,
-                            const hglasm::TrackerOptions& tracker, double min_scan_interval,
-                            std::size_t warnings_kept, double pace_rate) {
+                            const hglasm::TrackerOptions& tracker, double min_scan_interval, double pace_rate,
+                            std::size_t warnings_kept) {
   EvaluationRun run;
   hglasm::OdometryPipeline pipeline(tracker, nodelet.odometry_wait > 0.0);
   setLaserMount(data, &pipeline);

@@ -113,10 +113,17 @@ struct Recording {
   std::mutex mutex;
 };
 
-bool topicHasSubscriber(const std::string& topic) {
-  XmlRpc::XmlRpcValue request, response, payload;
+/// The master's getSystemState: [publishers, subscribers, services], each [name, [node...]]; false when the
+/// master does not answer.
+bool systemState(XmlRpc::XmlRpcValue* payload) {
+  XmlRpc::XmlRpcValue request, response;
   request[0] = ros::this_node::getName();
-  if (!ros::master::execute("getSystemState", request, response, payload, false)) return false;
+  return ros::master::execute("getSystemState", request, response, *payload, false);
+}
+
+bool topicHasSubscriber(const std::string& topic) {
+  XmlRpc::XmlRpcValue payload;
+  if (!systemState(&payload)) return false;
   XmlRpc::XmlRpcValue& subscribers = payload[1];
   for (int i = 0; i < subscribers.size(); ++i) {
     if (static_cast<std::string>(subscribers[i][0]) == topic && subscribers[i][1].size() > 0) return true;
@@ -127,9 +134,8 @@ bool topicHasSubscriber(const std::string& topic) {
 /// The names of the threads of the process of the node that publishes `topic` (it runs on this machine);
 /// empty when the master or the node does not answer.
 std::vector<std::string> threadNamesOfPublisher(const std::string& topic) {
-  XmlRpc::XmlRpcValue request, response, payload;
-  request[0] = ros::this_node::getName();
-  if (!ros::master::execute("getSystemState", request, response, payload, false)) return {};
+  XmlRpc::XmlRpcValue payload;
+  if (!systemState(&payload)) return {};
   std::string node;
   XmlRpc::XmlRpcValue& publishers = payload[0];
   for (int i = 0; i < publishers.size() && node.empty(); ++i) {
@@ -137,7 +143,7 @@ std::vector<std::string> threadNamesOfPublisher(const std::string& topic) {
       node = static_cast<std::string>(publishers[i][1][0]);
     }
   }
-  XmlRpc::XmlRpcValue lookup, uri;
+  XmlRpc::XmlRpcValue lookup, response, uri;
   lookup[0] = ros::this_node::getName();
   lookup[1] = node;
   if (node.empty() || !ros::master::execute("lookupNode", lookup, response, uri, false)) return {};

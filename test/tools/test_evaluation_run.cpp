@@ -60,27 +60,15 @@ std::string printed(const Print& print) {
   return text;
 }
 
-TEST(EvaluationRun, IsTheNodeletsPipelineReplayed) {
-  const Slice& s = slice();
-  hglasm::OdometryPipeline pipeline(s.options.tracker, s.options.odometry_wait > 0.0);
-  setLaserMount(s.data, &pipeline);
+/// The nodelet's waits and queue of the slice's options.
+ReplayOptions slicesReplay() {
   ReplayOptions replay;
-  replay.odometry_wait = s.options.odometry_wait;
-  replay.queue_size = static_cast<std::size_t>(s.options.queue_size);
-  std::vector<hglasm::StampedPose> expected;
-  replayBag(s.data, &pipeline, replay, [&expected](const ReplayedScan& replayed) {
-    if (replayed.update.tracker.published)
-      expected.push_back({replayed.scan->stamp, replayed.update.tracker.pose});
-  });
-  ASSERT_EQ(run().trajectory.size(), expected.size());
-  for (std::size_t i = 0; i < expected.size(); ++i) {
-    EXPECT_EQ(run().trajectory[i].stamp, expected[i].stamp);
-    EXPECT_EQ(run().trajectory[i].pose.x, expected[i].pose.x) << i;
-    EXPECT_EQ(run().trajectory[i].pose.theta, expected[i].pose.theta) << i;
-  }
+  replay.odometry_wait = slice().options.odometry_wait;
+  replay.queue_size = static_cast<std::size_t>(slice().options.queue_size);
+  return replay;
 }
 
-/// The trajectory of replaying `data` with `replay` (the slice's options).
+/// The published poses of replaying `data` with `replay` through a pipeline of the slice's options.
 std::vector<hglasm::StampedPose> replayed(const BagData& data, const ReplayOptions& replay) {
   hglasm::OdometryPipeline pipeline(slice().options.tracker, slice().options.odometry_wait > 0.0);
   setLaserMount(data, &pipeline);
@@ -89,6 +77,16 @@ std::vector<hglasm::StampedPose> replayed(const BagData& data, const ReplayOptio
     if (scan.update.tracker.published) poses.push_back({scan.scan->stamp, scan.update.tracker.pose});
   });
   return poses;
+}
+
+TEST(EvaluationRun, IsTheNodeletsPipelineReplayed) {
+  const std::vector<hglasm::StampedPose> expected = replayed(slice().data, slicesReplay());
+  ASSERT_EQ(run().trajectory.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(run().trajectory[i].stamp, expected[i].stamp);
+    EXPECT_EQ(run().trajectory[i].pose.x, expected[i].pose.x) << i;
+    EXPECT_EQ(run().trajectory[i].pose.theta, expected[i].pose.theta) << i;
+  }
 }
 
 TEST(EvaluationRun, APacedReplayTakesTheBagsTimeOverItsRateAndMatchesTheSame) {
@@ -102,9 +100,7 @@ TEST(EvaluationRun, APacedReplayTakesTheBagsTimeOverItsRateAndMatchesTheSame) {
     if (arrival.scan) last_scan = std::max(last_scan, data.scans[arrival.index].receive_time);
   }
   ASSERT_GT(last_scan - first, 1.0);
-  ReplayOptions replay;
-  replay.odometry_wait = slice().options.odometry_wait;
-  replay.queue_size = static_cast<std::size_t>(slice().options.queue_size);
+  ReplayOptions replay = slicesReplay();
   const std::vector<hglasm::StampedPose> unpaced = replayed(data, replay);
 
   replay.pace_rate = (last_scan - first) / 0.3;  // the last scan 0.3 s of wall time after the first

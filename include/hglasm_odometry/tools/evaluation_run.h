@@ -41,12 +41,12 @@ struct EvaluationRun {
 
 /// Runs the pipeline with `tracker` options over `data` as the nodelet with `nodelet` options receives
 /// it (replayBag: the bag's order, the nodelet's waits and queue), the scans first thinned to one per
-/// `min_scan_interval` seconds (a throttled topic; 0: all). Keeps the first `warnings_kept` warnings.
-/// `pace_rate` > 0 processes each scan no earlier than a live node playing the bag at that rate would
-/// receive it (ReplayOptions::pace_rate).
+/// `min_scan_interval` seconds (a throttled topic; 0: all). `pace_rate` > 0 processes each scan no earlier
+/// than a live node playing the bag at that rate would receive it (ReplayOptions::pace_rate). Keeps the
+/// first `warnings_kept` warnings.
 EvaluationRun runEvaluation(const BagData& data, const LaserOdometryOptions& nodelet,
                             const hglasm::TrackerOptions& tracker, double min_scan_interval,
-                            std::size_t warnings_kept = 20, double pace_rate = 0.0);
+                            double pace_rate = 0.0, std::size_t warnings_kept = 20);
 
 /// run->scored and run->interpolated from run->trajectory at the stamps of `data`'s scans (both sorted by
 /// stamp); scans before the first published pose or after the last stay unscored.
