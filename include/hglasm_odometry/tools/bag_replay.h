@@ -22,7 +22,8 @@ struct ReplayOptions {
   std::size_t queue_size = 5;
   /// > 0: each scan is processed no earlier (wall clock) than a live worker would turn to it (the bag's
   /// receive times from its first message, divided by this rate, as `rate`): the idle time between scans a
-  /// live node has, after which its core runs cold (caches, TLB). 0: as fast as it goes.
+  /// live node has, after which its caches are cold (doc/profile.md, "What idling costs"). 0: as fast as it
+  /// goes.
   double pace_rate = 0.0;
 };
 
