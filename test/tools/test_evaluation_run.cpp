@@ -85,6 +85,7 @@ TEST(EvaluationRun, IsTheNodeletsPipelineReplayed) {
   for (std::size_t i = 0; i < expected.size(); ++i) {
     EXPECT_EQ(run().trajectory[i].stamp, expected[i].stamp);
     EXPECT_EQ(run().trajectory[i].pose.x, expected[i].pose.x) << i;
+    EXPECT_EQ(run().trajectory[i].pose.y, expected[i].pose.y) << i;
     EXPECT_EQ(run().trajectory[i].pose.theta, expected[i].pose.theta) << i;
   }
 }
