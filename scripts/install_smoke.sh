@@ -8,7 +8,8 @@
 #   - every installed launch file loads (roslaunch --files), bag.launch's rviz points at the installed file;
 #   - evaluate runs on the installed bags/fr079_slice.bag with the installed config;
 #   - roslaunch bag.launch runs the nodelet on the installed fr079 slice and demo_report receives odometry and
-#     a match message for every one of its 500 scans.
+#     a match message for every one of its 500 scans, and writes the trajectories and the map picture into an
+#     output directory it makes (one it cannot make stops it with exit status 2).
 # Usage: bash scripts/install_smoke.sh   (builds what is missing in $HGLASM_BUILD; about 40 s once built)
 #   KEEP=1   keep the install prefix and logs (printed) instead of removing them
 # Exits non-zero on any failure.
@@ -79,6 +80,15 @@ if [[ "${1:-}" == "--from-install" ]]; then
     >"$logs/demo_report.log" 2>&1 || status=$?
   sed -n '/demo summary/,$p' "$logs/demo_report.log"
   ((status == 0)) || fail "demo_report exit status $status (not every scan came out), see $logs"
+  for file in trajectory.txt wheel_odometry.txt trajectory.gp map.png; do  # into a directory it makes
+    [[ -s "$logs/demo/$file" ]] || fail "demo_report did not write $logs/demo/$file"
+  done
+  # An output directory that cannot be made stops it before the bag plays, naming the option.
+  status=0
+  rosrun hglasm_odometry demo_report --bag "$share/bags/fr079_slice.bag" --output-dir "$logs/evaluate.log/demo" \
+    >"$logs/demo_report_bad_dir.log" 2>&1 || status=$?
+  ((status == 2)) && grep -q "cannot create --output-dir" "$logs/demo_report_bad_dir.log" ||
+    fail "demo_report with an output directory under a file: exit status $status, see $logs/demo_report_bad_dir.log"
   exit 0
 fi
 

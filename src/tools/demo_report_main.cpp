@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <mutex>
@@ -230,11 +231,14 @@ void printAccuracy(const Options& options, const std::vector<hglasm::StampedPose
 void writePlot(const Options& options, const std::vector<hglasm::StampedPose>& trajectory,
                const std::vector<hglasm::StampedPose>& wheel_trajectory) {
   const std::string dir = options.output_dir;
+  bool written = true;
   {
     std::ofstream out(dir + "/trajectory.txt");
     out << "# laser odometry: stamp x y theta (base_link in odom)\n";
     for (const auto& p : trajectory)
       out << std::fixed << p.stamp << " " << p.pose.x << " " << p.pose.y << " " << p.pose.theta << "\n";
+    out.close();
+    written = written && !out.fail();
   }
   {
     const hglasm::Pose2D laser_origin = trajectory.empty() ? hglasm::Pose2D() : trajectory.front().pose;
@@ -246,6 +250,8 @@ void writePlot(const Options& options, const std::vector<hglasm::StampedPose>& t
       const hglasm::Pose2D aligned = laser_origin * hglasm::relativePose(wheel_origin, p.pose);
       out << std::fixed << p.stamp << " " << aligned.x << " " << aligned.y << " " << aligned.theta << "\n";
     }
+    out.close();
+    written = written && !out.fail();
   }
   {
     const std::string laser = hglasm::gnuplotQuote(dir + "/trajectory.txt");
@@ -260,9 +266,15 @@ void writePlot(const Options& options, const std::vector<hglasm::StampedPose>& t
         << " using 2:3 with lines lw 1.5 lc rgb '#999999' title 'wheel odometry', \\\n     " << laser
         << " using 2:3 with lines lw 2 lc rgb '#d62728' title 'laser odometry (HGLASM-g)', \\\n     " << laser
         << " every ::0::0 using 2:3 with points pt 7 ps 1.5 lc rgb 'black' title 'start'\n";
+    out.close();
+    written = written && !out.fail();
   }
-  std::printf("  trajectory          %s/trajectory.txt (plot script %s/trajectory.gp)\n", dir.c_str(),
-              dir.c_str());
+  if (written) {
+    std::printf("  trajectory          %s/trajectory.txt (plot script %s/trajectory.gp)\n", dir.c_str(),
+                dir.c_str());
+  } else {
+    std::printf("  trajectory          not written: cannot write into %s\n", dir.c_str());
+  }
 }
 
 /// options.output_dir/map.png: the bag's scans (in the laser frame, mirrored for an upside-down laser) at
@@ -297,6 +309,14 @@ int main(int argc, char** argv) {
   Options options;
   const auto parsed = parseArguments(argc, argv, &options);
   if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
+  // Made now, so that a directory that cannot be written stops the demo before the bag plays.
+  std::error_code made;
+  std::filesystem::create_directories(options.output_dir, made);
+  if (made) {
+    std::cerr << "demo_report: cannot create --output-dir '" << options.output_dir << "': " << made.message()
+              << "\n";
+    return 2;
+  }
 
   // The bag: its scan stamps (what must come out) and wheel odometry (for comparison).
   std::vector<double> scan_stamps;
