@@ -165,8 +165,11 @@ std::string trajectoryPlotScript(const std::string& png, const std::string& titl
 }
 
 bool plotTrajectories(const std::string& png, const std::string& title, const std::vector<StampedPose>& laser,
-                      const std::vector<StampedPose>& wheel) {
-  if (laser.empty() && wheel.empty()) return false;
+                      const std::vector<StampedPose>& wheel, std::string* error) {
+  if (laser.empty() && wheel.empty()) {
+    if (error) *error = "no trajectory to plot into " + png;
+    return false;
+  }
   const std::string laser_data = png + ".laser.txt", wheel_data = png + ".wheel.txt",
                     script = png + ".gnuplot";
   const std::vector<StampedPose> aligned_wheel = laser.empty() ? wheel : startedAt(wheel, laser.front().pose);
@@ -179,6 +182,9 @@ bool plotTrajectories(const std::string& png, const std::string& title, const st
   }
   const bool plotted = written && runGnuplot(script);
   for (const std::string& file : {script, laser_data, wheel_data}) std::remove(file.c_str());
+  if (!plotted && error) {
+    *error = written ? "gnuplot failed for " + png : "cannot write " + laser_data + " beside " + png;
+  }
   return plotted;
 }
 

@@ -34,8 +34,9 @@ int writeOutputs(const EvaluateArguments& args, const std::string& preset,
   }
   if (!args.trace.empty()) std::printf("trace         %s\n", args.trace.c_str());
   const std::string title = args.bag.substr(args.bag.find_last_of('/') + 1) + ", preset " + preset;
-  if (!args.plot.empty() && !hglasm::plotTrajectories(args.plot, title, run.trajectory, wheel)) {
-    return fail("gnuplot failed for " + args.plot, 1);
+  std::string plot_error;
+  if (!args.plot.empty() && !hglasm::plotTrajectories(args.plot, title, run.trajectory, wheel, &plot_error)) {
+    return fail(plot_error, 1);
   }
   if (!args.plot.empty()) std::printf("plot          %s\n", args.plot.c_str());
   std::string error;

@@ -188,7 +188,16 @@ TEST(Trajectory, PlotScriptQuotesPathsAndTitleAndLeavesOutAMissingTrajectory) {
   const std::string laser_only = trajectoryPlotScript("/tmp/p.png", "t", "/tmp/l.txt", "");
   EXPECT_EQ(laser_only.find("wheel odometry"), std::string::npos) << laser_only;
   EXPECT_NE(laser_only.find("plot '/tmp/l.txt' using 2:3"), std::string::npos) << laser_only;
-  EXPECT_FALSE(plotTrajectories(testing::TempDir() + "hglasm_none.png", "t", {}, {}));
+  std::string error;
+  EXPECT_FALSE(plotTrajectories(testing::TempDir() + "hglasm_none.png", "t", {}, {}, &error));
+  EXPECT_EQ(error, "no trajectory to plot into " + testing::TempDir() + "hglasm_none.png");
+}
+
+TEST(Trajectory, PlotIntoADirectoryThatDoesNotExistSaysWhichFileItCannotWrite) {
+  const std::string png = testing::TempDir() + "hglasm_no_such_directory/plot.png";
+  std::string error;
+  EXPECT_FALSE(plotTrajectories(png, "t", {{0.0, Pose2D()}, {1.0, Pose2D(1.0, 0.0, 0.0)}}, {}, &error));
+  EXPECT_EQ(error, "cannot write " + png + ".laser.txt beside " + png);
 }
 
 TEST(Gnuplot, QuotesForGnuplotAndForTheShell) {

@@ -53,8 +53,9 @@ bool writeTrackerTrace(const std::string& path, const std::vector<TrackerUpdate>
 std::string trajectoryPlotScript(const std::string& png, const std::string& title,
                                  const std::string& laser_data, const std::string& wheel_data);
 
-/// Plots both trajectories into `png` (gnuplot), the wheels' started at the laser's first pose.
+/// Plots both trajectories into `png` (gnuplot), the wheels' started at the laser's first pose. False, and
+/// why in *error if given: nothing to plot, a file next to `png` that cannot be written, or gnuplot failed.
 bool plotTrajectories(const std::string& png, const std::string& title, const std::vector<StampedPose>& laser,
-                      const std::vector<StampedPose>& wheel);
+                      const std::vector<StampedPose>& wheel, std::string* error = nullptr);
 
 }  // namespace hglasm
