@@ -173,17 +173,21 @@ bool plotTrajectories(const std::string& png, const std::string& title, const st
   const std::string laser_data = png + ".laser.txt", wheel_data = png + ".wheel.txt",
                     script = png + ".gnuplot";
   const std::vector<StampedPose> aligned_wheel = laser.empty() ? wheel : startedAt(wheel, laser.front().pose);
-  bool written = writeTrajectory(laser_data, laser) && writeTrajectory(wheel_data, aligned_wheel);
-  if (written) {
+  std::string unwritten;  // the first file that could not be written
+  if (!writeTrajectory(laser_data, laser)) {
+    unwritten = laser_data;
+  } else if (!writeTrajectory(wheel_data, aligned_wheel)) {
+    unwritten = wheel_data;
+  } else {
     std::ofstream out(script);
     out << trajectoryPlotScript(png, title, laser.empty() ? "" : laser_data, wheel.empty() ? "" : wheel_data);
     out.close();
-    written = !out.fail();
+    if (out.fail()) unwritten = script;
   }
-  const bool plotted = written && runGnuplot(script);
+  const bool plotted = unwritten.empty() && runGnuplot(script);
   for (const std::string& file : {script, laser_data, wheel_data}) std::remove(file.c_str());
   if (!plotted && error) {
-    *error = written ? "gnuplot failed for " + png : "cannot write " + laser_data + " beside " + png;
+    *error = unwritten.empty() ? "gnuplot failed for " + png : "cannot write " + unwritten;
   }
   return plotted;
 }

@@ -309,7 +309,7 @@ int main(int argc, char** argv) {
   Options options;
   const auto parsed = parseArguments(argc, argv, &options);
   if (parsed != hglasm_odometry::ArgumentParser::Result::kOk) return hglasm_odometry::exitStatus(parsed);
-  // Made now, so that a directory that cannot be written stops the demo before the bag plays.
+  // Made now, so that a directory that cannot be made stops the demo before the bag plays.
   std::error_code made;
   std::filesystem::create_directories(options.output_dir, made);
   if (made) {

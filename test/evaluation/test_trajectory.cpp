@@ -197,7 +197,7 @@ TEST(Trajectory, PlotIntoADirectoryThatDoesNotExistSaysWhichFileItCannotWrite) {
   const std::string png = testing::TempDir() + "hglasm_no_such_directory/plot.png";
   std::string error;
   EXPECT_FALSE(plotTrajectories(png, "t", {{0.0, Pose2D()}, {1.0, Pose2D(1.0, 0.0, 0.0)}}, {}, &error));
-  EXPECT_EQ(error, "cannot write " + png + ".laser.txt beside " + png);
+  EXPECT_EQ(error, "cannot write " + png + ".laser.txt");
 }
 
 TEST(Gnuplot, QuotesForGnuplotAndForTheShell) {
