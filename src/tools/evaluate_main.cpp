@@ -34,12 +34,11 @@ int writeOutputs(const EvaluateArguments& args, const std::string& preset,
   }
   if (!args.trace.empty()) std::printf("trace         %s\n", args.trace.c_str());
   const std::string title = args.bag.substr(args.bag.find_last_of('/') + 1) + ", preset " + preset;
-  std::string plot_error;
-  if (!args.plot.empty() && !hglasm::plotTrajectories(args.plot, title, run.trajectory, wheel, &plot_error)) {
-    return fail(plot_error, 1);
+  std::string error;
+  if (!args.plot.empty() && !hglasm::plotTrajectories(args.plot, title, run.trajectory, wheel, &error)) {
+    return fail(error, 1);
   }
   if (!args.plot.empty()) std::printf("plot          %s\n", args.plot.c_str());
-  std::string error;
   if (!args.map.empty() && !writeScanMap(args.map, title + ": scans at the laser poses", data,
                                          pipelineConversion(options, data), run.trajectory, wheel, &error)) {
     return fail(error, 1);
